@@ -1,0 +1,180 @@
+#pragma once
+// The message bus: LCM behind an interface, so nodes run unchanged on UDP
+// multicast, in one process (memq://) or against a log file.
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/params.h"
+
+namespace nadir::core {
+
+class BusError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One message as delivered to a handler. The bytes are valid only during the call.
+struct RawMessage {
+  std::string_view channel;
+  const std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  // When the bus received it: wall clock for udpm and memq, the event time for a log.
+  std::int64_t recv_utime = 0;
+};
+
+using RawHandler = std::function<void(const RawMessage&)>;
+
+// Per-channel counters, for health reports.
+struct ChannelStats {
+  std::uint64_t messages = 0;
+  std::uint64_t bytes = 0;
+  std::uint64_t decode_errors = 0;
+};
+
+class Bus;
+
+// Keeps a subscription alive; unsubscribes when destroyed. Must not outlive its bus.
+class [[nodiscard]] Subscription {
+ public:
+  Subscription() = default;
+  Subscription(Bus* bus, int id) : bus_(bus), id_(id) {}
+  Subscription(Subscription&& other) noexcept;
+  Subscription& operator=(Subscription&& other) noexcept;
+  Subscription(const Subscription&) = delete;
+  Subscription& operator=(const Subscription&) = delete;
+  ~Subscription();
+
+  void unsubscribe();
+  bool active() const { return bus_ != nullptr; }
+
+ private:
+  Bus* bus_ = nullptr;
+  int id_ = -1;
+};
+
+class Bus {
+ public:
+  virtual ~Bus() = default;
+  Bus() = default;
+  Bus(const Bus&) = delete;
+  Bus& operator=(const Bus&) = delete;
+
+  // The URL this bus was opened with, after defaults were applied.
+  virtual std::string url() const = 0;
+
+  // Sends one encoded message. event_utime is the message's own time; a log
+  // writer stores it as the event timestamp, live transports ignore it.
+  virtual void publish(std::string_view channel, const void* data, std::size_t size,
+                       std::int64_t event_utime) = 0;
+
+  // Calls handler for every message whose channel fully matches channel_regex
+  // (LCM's POSIX extended regex semantics).
+  Subscription subscribe(const std::string& channel_regex, RawHandler handler);
+
+  // Waits up to timeout for one message and dispatches it to every matching
+  // handler. Returns false when nothing arrived (or a log has ended). An
+  // exception thrown by a handler is re-raised here, after the dispatch.
+  virtual bool handle(std::chrono::milliseconds timeout) = 0;
+
+  // Dispatches what is already waiting without blocking; returns how many messages.
+  int handleAvailable();
+
+  // Counters per channel, of every message this bus received.
+  std::map<std::string, ChannelStats> stats() const;
+
+  // Called by the typed subscribe when bytes do not decode as the expected type.
+  void countDecodeError(std::string_view channel);
+
+ protected:
+  struct Handler {
+    int id;
+    std::string channel_regex;
+    RawHandler callback;
+  };
+  virtual void addSubscription(const Handler& handler) = 0;
+  virtual void removeSubscription(int id) = 0;
+  void countMessage(std::string_view channel, std::size_t size);
+
+ private:
+  friend class Subscription;
+  int next_id_ = 0;
+  mutable std::mutex stats_mutex_;
+  std::map<std::string, ChannelStats, std::less<>> stats_;
+};
+
+// Where a node's bus goes; every node has these under "bus" in its parameters.
+struct BusParams {
+  std::string url;
+  std::int64_t recv_buf_size_bytes = 0;
+
+  void visit(ParamVisitor& v);
+  // url with defaults applied and, for udpm://, recv_buf_size added when set here.
+  std::string resolvedUrl() const;
+};
+
+// Opens a bus from a URL:
+//   udpm://ADDR:PORT?ttl=N[&recv_buf_size=BYTES]   UDP multicast (LCM)
+//   memq://                                         in this process only
+//   file://PATH?mode=r[&speed=S] | ?mode=w          an LCM log file (see LogBus)
+// An empty URL means $LCM_DEFAULT_URL, else LCM's default udpm URL.
+std::unique_ptr<Bus> openBus(const std::string& url);
+
+std::unique_ptr<Bus> openBus(const BusParams& params);
+
+// The URL an empty url resolves to here.
+std::string defaultBusUrl();
+
+// ---- typed helpers over lcm-gen types (no lcm-cpp.hpp needed) ----
+
+template <class Msg>
+std::vector<std::uint8_t> encodeMessage(const Msg& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  if (msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0) {
+    throw BusError(std::string("cannot encode ") + Msg::getTypeName());
+  }
+  return bytes;
+}
+
+// Decodes bytes into msg; false if they are not a whole Msg (wrong type, truncated).
+template <class Msg>
+bool decodeMessage(const void* data, std::size_t size, Msg& msg) {
+  return msg.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size);
+}
+
+// Every nadir message starts with int64 utime right after LCM's 8-byte
+// fingerprint; this reads it without knowing the type (nothing if too short).
+std::optional<std::int64_t> peekUtime(const RawMessage& message);
+
+template <class Msg>
+void publish(Bus& bus, std::string_view channel, const Msg& msg) {
+  const std::vector<std::uint8_t> bytes = encodeMessage(msg);
+  bus.publish(channel, bytes.data(), bytes.size(), msg.utime);
+}
+
+// Subscribes with decoding. A message that does not decode as Msg is dropped
+// and counted in stats().decode_errors; the handler never sees it.
+template <class Msg>
+Subscription subscribe(Bus& bus, const std::string& channel_regex,
+                       std::function<void(const Msg&)> handler) {
+  return bus.subscribe(channel_regex, [&bus, handler = std::move(handler)](const RawMessage& raw) {
+    Msg msg;
+    if (!decodeMessage(raw.data, raw.size, msg)) {
+      bus.countDecodeError(raw.channel);
+      return;
+    }
+    handler(msg);
+  });
+}
+
+}  // namespace nadir::core

@@ -1,0 +1,94 @@
+#pragma once
+// Parameters: one struct per module, every field defaulted and documented,
+// loaded from YAML. A struct lists its fields once, in a visit() member:
+//
+//   struct CameraParams {
+//     double fps = 30.0;  // frame rate, Hz
+//     void visit(ParamVisitor& v) {
+//       v.field("fps", &fps, {.doc = "frame rate, Hz", .min = 0.1, .max = 2000});
+//     }
+//   };
+//
+// and everything else (loading, --set overrides, validation, printing) walks
+// that list. An unknown key, a wrong type or an out-of-range value is a
+// ParamError naming the file, line and key.
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace nadir::core {
+
+class ParamError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ParamSpec {
+  std::string_view doc;
+  // Inclusive bounds for numbers and for every element of a list.
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  // Allowed values of a string field; empty allows any.
+  std::vector<std::string_view> choices = {};
+  // Required length of a list field; 0 allows any.
+  std::size_t list_size = 0;
+};
+
+using ParamRef =
+    std::variant<bool*, int*, std::int64_t*, double*, std::string*, std::vector<double>*>;
+
+class ParamVisitor {
+ public:
+  virtual ~ParamVisitor() = default;
+  virtual void field(std::string_view key, ParamRef value, const ParamSpec& spec) = 0;
+  // A nested struct under key; visit_members lists its fields.
+  virtual void group(std::string_view key, std::string_view doc,
+                     const std::function<void(ParamVisitor&)>& visit_members) = 0;
+};
+
+using VisitParams = std::function<void(ParamVisitor&)>;
+
+// Nests a params struct P (with a visit member) under key.
+template <class P>
+void visitGroup(ParamVisitor& visitor, std::string_view key, std::string_view doc, P& params) {
+  visitor.group(key, doc, [&params](ParamVisitor& inner) { params.visit(inner); });
+}
+
+// Applies a YAML map to the fields. source names the file in errors.
+void applyYamlFile(const std::string& path, const VisitParams& visit);
+void applyYamlText(std::string_view yaml, std::string_view source, const VisitParams& visit);
+// Applies "dotted.key=value" (value in YAML syntax: 3, true, [1, 2], text).
+void applyAssignment(std::string_view assignment, std::string_view source,
+                     const VisitParams& visit);
+// Checks every current value against its spec (for values set in code).
+void validateParams(const VisitParams& visit, std::string_view source);
+// YAML text of every field with its value and documentation.
+std::string formatParams(const VisitParams& visit);
+
+template <class P>
+P loadParams(const std::string& path) {
+  P params;
+  applyYamlFile(path, [&params](ParamVisitor& v) { params.visit(v); });
+  return params;
+}
+
+template <class P>
+void applyAssignments(P& params, const std::vector<std::string>& assignments,
+                      std::string_view source = "--set") {
+  for (const std::string& assignment : assignments) {
+    applyAssignment(assignment, source, [&params](ParamVisitor& v) { params.visit(v); });
+  }
+}
+
+template <class P>
+std::string formatParamsOf(P& params) {
+  return formatParams([&params](ParamVisitor& v) { params.visit(v); });
+}
+
+}  // namespace nadir::core
