@@ -96,7 +96,8 @@ CheckResult checkUdpmSelfTest(const std::string& url) {
       result.fix = {"sudo ip link set lo multicast on", "sudo ip route add 224.0.0.0/4 dev lo"};
     } else if (large_received < kLarge) {
       result.status = CheckStatus::kFail;
-      result.detail += ": raise the UDP receive buffers";
+      result.detail += ": the UDP receive buffers are too small for camera images";
+      result.fix = receiveBufferFix();
     } else {
       result.status = CheckStatus::kOk;
     }

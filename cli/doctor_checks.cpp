@@ -133,11 +133,15 @@ CheckResult checkReceiveBuffers(std::int64_t rmem_max_bytes, std::int64_t rmem_d
   result.detail += ": camera images over udpm:// need at least " +
                    mebibytes(kMinimumReceiveBufferBytes) + " (recommended " +
                    mebibytes(kRecommendedReceiveBufferBytes) + ")";
-  const std::string value = std::to_string(kRecommendedReceiveBufferBytes);
-  result.fix = {"sudo sysctl -w net.core.rmem_max=" + value + " net.core.rmem_default=" + value,
-                "printf 'net.core.rmem_max=" + value + "\\nnet.core.rmem_default=" + value +
-                    "\\n' | sudo tee /etc/sysctl.d/60-nadir-lcm.conf   # keep it after reboot"};
+  result.fix = receiveBufferFix();
   return result;
+}
+
+std::vector<std::string> receiveBufferFix() {
+  const std::string value = std::to_string(kRecommendedReceiveBufferBytes);
+  return {"sudo sysctl -w net.core.rmem_max=" + value + " net.core.rmem_default=" + value,
+          "printf 'net.core.rmem_max=" + value + "\\nnet.core.rmem_default=" + value +
+              "\\n' | sudo tee /etc/sysctl.d/60-nadir-lcm.conf   # keep it after reboot"};
 }
 
 }  // namespace nadir::cli

@@ -41,6 +41,9 @@ CheckResult checkMulticastRoute(const std::vector<Ipv4Route>& routes, std::uint3
 // Receive buffer sizes against what camera images need over udpm.
 CheckResult checkReceiveBuffers(std::int64_t rmem_max_bytes, std::int64_t rmem_default_bytes);
 
+// The commands that raise the receive buffers to the recommended size.
+std::vector<std::string> receiveBufferFix();
+
 // Receive buffer sizes, bytes: below the minimum, 1280x960 gray frames are lost
 // over loopback udpm (docs/benchmarks.md has the measurement).
 constexpr std::int64_t kMinimumReceiveBufferBytes = 32LL * 1024 * 1024;
