@@ -1,0 +1,107 @@
+#include "render/camera_model.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace nadir::render {
+
+CameraIntrinsics CameraIntrinsics::fromHorizontalFov(int width, int height, double hfov_rad) {
+  CameraIntrinsics k;
+  k.width = width;
+  k.height = height;
+  k.fx = 0.5 * width / std::tan(0.5 * hfov_rad);
+  k.fy = k.fx;
+  k.cx = 0.5 * (width - 1);
+  k.cy = 0.5 * (height - 1);
+  return k;
+}
+
+double CameraIntrinsics::horizontalFov_rad() const { return 2.0 * std::atan(0.5 * width / fx); }
+
+bool CameraIntrinsics::hasDistortion() const {
+  for (double c : distortion) {
+    if (c != 0.0) return true;
+  }
+  return false;
+}
+
+Eigen::Vector2d CameraIntrinsics::distortNormalised(const Eigen::Vector2d& xy) const {
+  const double x = xy.x(), y = xy.y();
+  const auto [k1, k2, p1, p2, k3] = distortion;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  return {fx * xd + cx, fy * yd + cy};
+}
+
+Eigen::Vector2d CameraIntrinsics::project(const Eigen::Vector3d& p_cam) const {
+  return distortNormalised({p_cam.x() / p_cam.z(), p_cam.y() / p_cam.z()});
+}
+
+std::optional<Eigen::Vector2d> CameraIntrinsics::undistortPixel(const Eigen::Vector2d& uv) const {
+  const Eigen::Vector2d xd((uv.x() - cx) / fx, (uv.y() - cy) / fy);
+  if (!hasDistortion()) return xd;
+  const auto [k1, k2, p1, p2, k3] = distortion;
+  Eigen::Vector2d xy = xd;
+  for (int i = 0; i < 100; ++i) {
+    const double x = xy.x(), y = xy.y();
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+    const double dy = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+    const Eigen::Vector2d next((xd.x() - dx) / radial, (xd.y() - dy) / radial);
+    const double step = (next - xy).norm();
+    xy = next;
+    if (step < 1e-12) break;
+  }
+  const Eigen::Vector2d back = distortNormalised(xy);
+  if (!std::isfinite(back.x()) || (back - uv).norm() > 1e-6) return std::nullopt;
+  return xy;
+}
+
+void CameraParams::visit(core::ParamVisitor& v) {
+  v.field("width", &width, {.doc = "image width, px", .min = 16, .max = 8192});
+  v.field("height", &height, {.doc = "image height, px", .min = 16, .max = 8192});
+  v.field("hfov_deg", &hfov_deg,
+          {.doc = "horizontal field of view, deg (used when fx = 0)", .min = 1, .max = 170});
+  v.field("fx", &fx, {.doc = "focal length x, px; 0 = from hfov_deg", .min = 0, .max = 1e6});
+  v.field("fy", &fy, {.doc = "focal length y, px; 0 = fx", .min = 0, .max = 1e6});
+  v.field("cx", &cx,
+          {.doc = "principal point x, px; cx = cy = 0: image centre", .min = -1e5, .max = 1e5});
+  v.field("cy", &cy,
+          {.doc = "principal point y, px; cx = cy = 0: image centre", .min = -1e5, .max = 1e5});
+  v.field("distortion", &distortion,
+          {.doc = "Brown-Conrady k1 k2 p1 p2 k3 (OpenCV order)",
+           .min = -10,
+           .max = 10,
+           .list_size = 5});
+  v.field("near_m", &near_m, {.doc = "near clipping distance, m", .min = 1e-3, .max = 1e4});
+  v.field("far_m", &far_m, {.doc = "far clipping distance, m", .min = 1, .max = 1e6});
+  v.field("pixel_format", &pixel_format, {.doc = "gray8 or rgb8", .choices = {"gray8", "rgb8"}});
+  v.field("gain", &gain, {.doc = "linear gain on the rendered radiance", .min = 0, .max = 100});
+  v.field("read_noise_counts", &read_noise_counts,
+          {.doc = "Gaussian read noise, std dev in 8-bit counts; 0 = off", .min = 0, .max = 255});
+  v.field("shot_noise_electrons_per_count", &shot_noise_electrons_per_count,
+          {.doc = "electrons per count for shot noise; 0 = off", .min = 0, .max = 1e6});
+  v.field("noise_seed", &noise_seed, {.doc = "seed of the per-frame noise"});
+  v.field("ground_detail", &ground_detail,
+          {.doc = "add texture finer than the imagery for low altitudes"});
+}
+
+CameraIntrinsics CameraParams::intrinsics() const {
+  CameraIntrinsics k =
+      CameraIntrinsics::fromHorizontalFov(width, height, hfov_deg * std::numbers::pi / 180.0);
+  if (fx > 0.0) {
+    k.fx = fx;
+    k.fy = fy > 0.0 ? fy : fx;
+    if (cx != 0.0 || cy != 0.0) {
+      k.cx = cx;
+      k.cy = cy;
+    }
+  }
+  for (std::size_t i = 0; i < k.distortion.size(); ++i) k.distortion[i] = distortion[i];
+  return k;
+}
+
+}  // namespace nadir::render

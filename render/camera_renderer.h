@@ -1,0 +1,62 @@
+#pragma once
+// A virtual camera: renders the terrain from a pose into an offscreen
+// framebuffer, applies lens distortion and sensor noise, and reads the image
+// (and optionally per-pixel depth) back. Deterministic: the same pose, utime
+// and parameters give bit-identical images.
+
+#include <cstdint>
+#include <memory>
+
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+
+#include "render/camera_model.h"
+#include "render/terrain_renderer.h"
+
+namespace nadir::render {
+
+struct RenderedImage {
+  std::int64_t utime = 0;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  // CV_8UC1 (gray8) or CV_8UC3 with R first (rgb8); row 0 is the image top.
+  cv::Mat image;
+  // CV_32FC1 depth along the optical axis, m, +inf where no ground was hit;
+  // empty unless asked for.
+  cv::Mat depth_m;
+  DrawStats stats;
+};
+
+class CameraRenderer {
+ public:
+  // Needs the GL context the terrain renderer was made in, current.
+  CameraRenderer(TerrainRenderer& terrain, const CameraParams& params);
+  ~CameraRenderer();
+  CameraRenderer(const CameraRenderer&) = delete;
+  CameraRenderer& operator=(const CameraRenderer&) = delete;
+
+  RenderedImage render(const Eigen::Isometry3d& T_world_cam, std::int64_t utime,
+                       bool with_depth = false);
+
+  const CameraIntrinsics& intrinsics() const { return intrinsics_; }
+  const CameraParams& params() const { return params_; }
+
+ private:
+  struct Target;
+  void createTargets();
+
+  TerrainRenderer& terrain_;
+  CameraParams params_;
+  CameraIntrinsics intrinsics_;
+  // The undistorted camera the scene is drawn with (wider when distortion is on).
+  CameraIntrinsics scene_intrinsics_;
+  bool post_pass_ = false;
+  std::unique_ptr<Target> scene_;
+  std::unique_ptr<Target> output_;
+  unsigned int post_program_ = 0;
+  unsigned int post_vertex_array_ = 0;
+  unsigned int distortion_map_ = 0;
+  // Scene pixel coordinates of each output pixel (for depth with distortion).
+  cv::Mat map_x_, map_y_;
+};
+
+}  // namespace nadir::render

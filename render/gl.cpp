@@ -1,0 +1,62 @@
+#include "render/gl.h"
+
+#include <vector>
+
+#include "render/egl_context.h"
+
+namespace nadir::render {
+namespace {
+
+GLuint compile(const std::string& name, GLenum stage, const std::string& source) {
+  const GLuint shader = glCreateShader(stage);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::vector<char> log(static_cast<std::size_t>(std::max(length, 1)));
+    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    glDeleteShader(shader);
+    throw GlContextError("shader " + name +
+                         (stage == GL_VERTEX_SHADER ? " (vertex)" : " (fragment)") +
+                         " does not compile: " + log.data());
+  }
+  return shader;
+}
+
+}  // namespace
+
+GLuint linkProgram(const std::string& name, const std::string& vertex_source,
+                   const std::string& fragment_source) {
+  const GLuint vertex = compile(name, GL_VERTEX_SHADER, vertex_source);
+  const GLuint fragment = compile(name, GL_FRAGMENT_SHADER, fragment_source);
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vertex);
+  glAttachShader(program, fragment);
+  glLinkProgram(program);
+  glDeleteShader(vertex);
+  glDeleteShader(fragment);
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    GLint length = 0;
+    glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+    std::vector<char> log(static_cast<std::size_t>(std::max(length, 1)));
+    glGetProgramInfoLog(program, length, nullptr, log.data());
+    glDeleteProgram(program);
+    throw GlContextError("shader program " + name + " does not link: " + log.data());
+  }
+  return program;
+}
+
+void checkGl(const char* what) {
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) {
+    throw GlContextError(std::string("OpenGL error 0x") + std::to_string(error) + " in " + what);
+  }
+}
+
+}  // namespace nadir::render

@@ -1,0 +1,337 @@
+#include "render/terrain_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/detail_texture.h"
+#include "render/gl.h"
+
+namespace nadir::render {
+namespace {
+
+constexpr const char* kVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 local_ned;
+uniform mat4 u_clip_from_local;
+uniform float u_size_m;
+uniform float u_texture_px;
+uniform vec2 u_detail_origin_1;
+uniform vec2 u_detail_origin_2;
+uniform mat2 u_detail_rotation_2;
+out vec2 v_uv;
+out vec2 v_detail_1;
+out vec2 v_detail_2;
+const float kDetailRepeat1_m = 10.24;
+const float kDetailRepeat2_m = 71.68;
+void main() {
+  gl_Position = u_clip_from_local * vec4(local_ned, 1.0);
+  // Texture row 0 is the north edge; one border texel on each side.
+  float texels = u_texture_px + 2.0;
+  v_uv = vec2((1.0 + local_ned.y / u_size_m * u_texture_px) / texels,
+              (1.0 + (u_size_m - local_ned.x) / u_size_m * u_texture_px) / texels);
+  v_detail_1 = (u_detail_origin_1 + local_ned.yx) / kDetailRepeat1_m;
+  v_detail_2 = (u_detail_origin_2 + u_detail_rotation_2 * local_ned.yx) / kDetailRepeat2_m;
+}
+)";
+
+constexpr const char* kFragmentShader = R"(
+in vec2 v_uv;
+in vec2 v_detail_1;
+in vec2 v_detail_2;
+uniform sampler2D u_imagery;
+uniform sampler2D u_detail;
+uniform float u_gain;
+uniform float u_detail_contrast;
+uniform bool u_gray;
+out vec4 out_colour;
+void main() {
+  vec3 colour = texture(u_imagery, v_uv).rgb * u_gain;
+#ifdef GROUND_DETAIL
+  // Multiplicative, so the detail follows the imagery's brightness; its mean is
+  // neutral, so once mipmapping averages it away the imagery is unchanged.
+  float detail = (texture(u_detail, v_detail_1).r - 0.5) + 0.6 * (texture(u_detail, v_detail_2).r - 0.5);
+  colour *= 1.0 + 2.0 * u_detail_contrast * detail;
+#endif
+  if (u_gray) {
+    out_colour = vec4(dot(colour, vec3(0.299, 0.587, 0.114)), 0.0, 0.0, 1.0);
+  } else {
+    out_colour = vec4(colour, 1.0);
+  }
+}
+)";
+
+constexpr double kDetailRepeat1_m = 10.24;
+constexpr double kDetailRepeat2_m = 71.68;
+constexpr double kDetailAngle2_rad = 0.61;
+
+double positiveMod(double value, double period) {
+  const double r = std::fmod(value, period);
+  return r < 0.0 ? r + period : r;
+}
+
+Eigen::Matrix4d clipFromCamera(const CameraIntrinsics& k, double near_m, double far_m) {
+  // Optical frame to clip space such that image row 0 lands on the framebuffer's
+  // bottom row: glReadPixels then returns the image top row first.
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  P(0, 0) = 2.0 * k.fx / k.width;
+  P(0, 2) = 2.0 * (k.cx + 0.5) / k.width - 1.0;
+  P(1, 1) = 2.0 * k.fy / k.height;
+  P(1, 2) = 2.0 * (k.cy + 0.5) / k.height - 1.0;
+  P(2, 2) = (far_m + near_m) / (far_m - near_m);
+  P(2, 3) = -2.0 * far_m * near_m / (far_m - near_m);
+  P(3, 2) = 1.0;
+  return P;
+}
+
+}  // namespace
+
+struct TerrainRenderer::GpuTile {
+  GLuint vertex_array = 0;
+  GLuint vertex_buffer = 0;
+  GLuint texture = 0;
+  std::size_t bytes = 0;
+  terrain::GroundSquare square;
+  std::list<std::uint64_t>::iterator lru_position;
+
+  ~GpuTile() {
+    glDeleteTextures(1, &texture);
+    glDeleteBuffers(1, &vertex_buffer);
+    glDeleteVertexArrays(1, &vertex_array);
+  }
+};
+
+void TerrainRendererParams::visit(core::ParamVisitor& v) {
+  v.field(
+      "tile_cache_mib", &tile_cache_mib,
+      {.doc = "memory for tile meshes and textures on the GL side, MiB", .min = 16, .max = 65536});
+  v.field(
+      "detail_contrast", &detail_contrast,
+      {.doc = "contrast of the texture added below the imagery's resolution", .min = 0, .max = 1});
+}
+
+TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
+                                 const TerrainRendererParams& params)
+    : tiles_(std::move(tiles)), params_(params) {
+  const std::string fragment_plain = std::string("#version 450 core\n") + kFragmentShader;
+  const std::string fragment_detail =
+      std::string("#version 450 core\n#define GROUND_DETAIL 1\n") + kFragmentShader;
+  program_plain_ = linkProgram("terrain", kVertexShader, fragment_plain);
+  program_detail_ = linkProgram("terrain+detail", kVertexShader, fragment_detail);
+
+  // One index buffer serves every tile: the grid, then a skirt down from each
+  // edge that hides cracks between tiles of different levels.
+  const int q = tiles_->params().mesh_quads;
+  const int n = q + 1;
+  std::vector<GLuint> indices;
+  const auto grid = [n](int r, int c) { return static_cast<GLuint>(r * n + c); };
+  for (int r = 0; r < q; ++r) {
+    for (int c = 0; c < q; ++c) {
+      indices.insert(indices.end(), {grid(r, c), grid(r, c + 1), grid(r + 1, c + 1), grid(r, c),
+                                     grid(r + 1, c + 1), grid(r + 1, c)});
+    }
+  }
+  const auto skirt = [n](int edge, int i) { return static_cast<GLuint>(n * n + edge * n + i); };
+  for (int i = 0; i < q; ++i) {
+    const GLuint edges[4][2] = {{grid(0, i), grid(0, i + 1)},
+                                {grid(q, i), grid(q, i + 1)},
+                                {grid(i, 0), grid(i + 1, 0)},
+                                {grid(i, q), grid(i + 1, q)}};
+    for (int edge = 0; edge < 4; ++edge) {
+      indices.insert(indices.end(), {edges[edge][0], edges[edge][1], skirt(edge, i + 1),
+                                     edges[edge][0], skirt(edge, i + 1), skirt(edge, i)});
+    }
+  }
+  index_count_ = static_cast<int>(indices.size());
+  glGenBuffers(1, &index_buffer_);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer_);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
+               indices.data(), GL_STATIC_DRAW);
+
+  const cv::Mat detail = makeDetailTexture();
+  glGenTextures(1, &detail_texture_);
+  glBindTexture(GL_TEXTURE_2D, detail_texture_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, detail.cols, detail.rows, 0, GL_RED, GL_UNSIGNED_BYTE,
+               detail.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  checkGl("creating the terrain renderer");
+}
+
+TerrainRenderer::~TerrainRenderer() {
+  gpu_tiles_.clear();
+  glDeleteTextures(1, &detail_texture_);
+  glDeleteBuffers(1, &index_buffer_);
+  glDeleteProgram(program_plain_);
+  glDeleteProgram(program_detail_);
+}
+
+terrain::LodView lodViewOf(const DrawView& view) {
+  terrain::LodView lod;
+  lod.camera_ned = view.T_world_cam.translation();
+  lod.focal_px = std::max(view.intrinsics.fx, view.intrinsics.fy);
+  const Eigen::Matrix3d R_world_cam = view.T_world_cam.rotation();
+  const CameraIntrinsics& k = view.intrinsics;
+  // Side planes through the camera centre and the image's outer pixel edges.
+  const double left = (-0.5 - k.cx) / k.fx, right = (k.width - 0.5 - k.cx) / k.fx;
+  const double top = (-0.5 - k.cy) / k.fy, bottom = (k.height - 0.5 - k.cy) / k.fy;
+  const Eigen::Vector3d normals_cam[4] = {Eigen::Vector3d(1.0, 0.0, -left).normalized(),
+                                          Eigen::Vector3d(-1.0, 0.0, right).normalized(),
+                                          Eigen::Vector3d(0.0, 1.0, -top).normalized(),
+                                          Eigen::Vector3d(0.0, -1.0, bottom).normalized()};
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector3d n = R_world_cam * normals_cam[i];
+    lod.frustum_planes[static_cast<std::size_t>(i)] << n, -n.dot(lod.camera_ned);
+  }
+  const Eigen::Vector3d forward = R_world_cam.col(2);
+  lod.frustum_planes[4] << forward, -forward.dot(lod.camera_ned) - view.near_m;
+  lod.frustum_planes[5] << -forward, forward.dot(lod.camera_ned) + view.far_m;
+  return lod;
+}
+
+std::vector<terrain::TileId> TerrainRenderer::visibleTiles(const DrawView& view) {
+  return tiles_->select(lodViewOf(view));
+}
+
+TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, int& uploaded) {
+  const std::uint64_t key = id.key();
+  const auto found = gpu_tiles_.find(key);
+  if (found != gpu_tiles_.end()) {
+    lru_.splice(lru_.begin(), lru_, found->second->lru_position);
+    return *found->second;
+  }
+  const std::shared_ptr<const terrain::TileGeometry> geometry = tiles_->geometry(id);
+  const int n = geometry->vertices_per_edge;
+  const int q = n - 1;
+  const double step_m = geometry->square.size_m / q;
+  // Skirts reach below the mesh by more than the error of any neighbour's level.
+  const float skirt_m = static_cast<float>(
+      std::max(2.0 * geometry->geometric_error_m, 0.02 * geometry->square.size_m));
+  std::vector<float> vertices;
+  vertices.reserve(static_cast<std::size_t>(n * n + 4 * n) * 3);
+  const auto vertex = [&](int r, int c, float extra_down_m) {
+    vertices.push_back(static_cast<float>(r * step_m));
+    vertices.push_back(static_cast<float>(c * step_m));
+    vertices.push_back(-geometry->height_up_m[static_cast<std::size_t>(r) * n + c] + extra_down_m);
+  };
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) vertex(r, c, 0.0f);
+  }
+  for (int i = 0; i < n; ++i) vertex(0, i, skirt_m);
+  for (int i = 0; i < n; ++i) vertex(q, i, skirt_m);
+  for (int i = 0; i < n; ++i) vertex(i, 0, skirt_m);
+  for (int i = 0; i < n; ++i) vertex(i, q, skirt_m);
+
+  auto tile = std::make_unique<GpuTile>();
+  tile->square = geometry->square;
+  glGenVertexArrays(1, &tile->vertex_array);
+  glBindVertexArray(tile->vertex_array);
+  glGenBuffers(1, &tile->vertex_buffer);
+  glBindBuffer(GL_ARRAY_BUFFER, tile->vertex_buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
+               vertices.data(), GL_STATIC_DRAW);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(0);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer_);
+  glBindVertexArray(0);
+
+  const cv::Mat rgb = tiles_->imagery(id);
+  glGenTextures(1, &tile->texture);
+  glBindTexture(GL_TEXTURE_2D, tile->texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
+               rgb.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  tile->bytes =
+      vertices.size() * sizeof(float) + static_cast<std::size_t>(rgb.cols) * rgb.rows * 4 * 4 / 3;
+  gpu_bytes_ += tile->bytes;
+  lru_.push_front(key);
+  tile->lru_position = lru_.begin();
+  ++uploaded;
+  return *gpu_tiles_.emplace(key, std::move(tile)).first->second;
+}
+
+void TerrainRenderer::evictBeyondBudget(const std::vector<terrain::TileId>& in_use) {
+  const auto budget = static_cast<std::size_t>(params_.tile_cache_mib * 1024 * 1024);
+  // The least recently used tiles go first; never one the current frame drew.
+  while (gpu_bytes_ > budget && lru_.size() > in_use.size()) {
+    const std::uint64_t key = lru_.back();
+    lru_.pop_back();
+    const auto it = gpu_tiles_.find(key);
+    gpu_bytes_ -= it->second->bytes;
+    gpu_tiles_.erase(it);
+  }
+}
+
+DrawStats TerrainRenderer::draw(const DrawView& view) {
+  DrawStats stats;
+  const std::vector<terrain::TileId> visible = visibleTiles(view);
+  const GLuint program = view.ground_detail ? program_detail_ : program_plain_;
+  glUseProgram(program);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glClearColor(0.5f, 0.5f, 0.5f, 1.0f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+  const GLint clip_from_local = glGetUniformLocation(program, "u_clip_from_local");
+  const GLint size_m = glGetUniformLocation(program, "u_size_m");
+  const GLint detail_origin_1 = glGetUniformLocation(program, "u_detail_origin_1");
+  const GLint detail_origin_2 = glGetUniformLocation(program, "u_detail_origin_2");
+  glUniform1f(glGetUniformLocation(program, "u_texture_px"),
+              static_cast<float>(tiles_->params().texture_px));
+  glUniform1f(glGetUniformLocation(program, "u_gain"), static_cast<float>(view.gain));
+  glUniform1f(glGetUniformLocation(program, "u_detail_contrast"),
+              static_cast<float>(params_.detail_contrast));
+  glUniform1i(glGetUniformLocation(program, "u_gray"), view.gray ? 1 : 0);
+  glUniform1i(glGetUniformLocation(program, "u_imagery"), 0);
+  glUniform1i(glGetUniformLocation(program, "u_detail"), 1);
+  const float c2 = static_cast<float>(std::cos(kDetailAngle2_rad));
+  const float s2 = static_cast<float>(std::sin(kDetailAngle2_rad));
+  const float rotation_2[4] = {c2, s2, -s2, c2};  // column-major
+  glUniformMatrix2fv(glGetUniformLocation(program, "u_detail_rotation_2"), 1, GL_FALSE, rotation_2);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, detail_texture_);
+  glActiveTexture(GL_TEXTURE0);
+
+  const Eigen::Matrix4d P = clipFromCamera(view.intrinsics, view.near_m, view.far_m);
+  const Eigen::Matrix3d R_cam_world = view.T_world_cam.rotation().transpose();
+  const Eigen::Vector3d camera_ned = view.T_world_cam.translation();
+  for (const terrain::TileId& id : visible) {
+    GpuTile& tile = acquire(id, stats.tiles_uploaded);
+    // Camera-relative in double, then float: full precision near the camera.
+    const Eigen::Vector3d origin_ned(tile.square.north_min_m, tile.square.east_min_m, 0.0);
+    Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
+    camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
+    camera_from_local.topRightCorner<3, 1>() = R_cam_world * (origin_ned - camera_ned);
+    const Eigen::Matrix4f clip = (P * camera_from_local).cast<float>();
+    glUniformMatrix4fv(clip_from_local, 1, GL_FALSE, clip.data());
+    glUniform1f(size_m, static_cast<float>(tile.square.size_m));
+    const double east = tile.square.east_min_m, north = tile.square.north_min_m;
+    glUniform2f(detail_origin_1, static_cast<float>(positiveMod(east, kDetailRepeat1_m)),
+                static_cast<float>(positiveMod(north, kDetailRepeat1_m)));
+    const double c = std::cos(kDetailAngle2_rad), s = std::sin(kDetailAngle2_rad);
+    glUniform2f(detail_origin_2,
+                static_cast<float>(positiveMod(c * east - s * north, kDetailRepeat2_m)),
+                static_cast<float>(positiveMod(s * east + c * north, kDetailRepeat2_m)));
+    glBindTexture(GL_TEXTURE_2D, tile.texture);
+    glBindVertexArray(tile.vertex_array);
+    glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+    ++stats.tiles;
+    stats.triangles += index_count_ / 3;
+  }
+  glBindVertexArray(0);
+  evictBeyondBudget(visible);
+  checkGl("drawing the terrain");
+  return stats;
+}
+
+}  // namespace nadir::render

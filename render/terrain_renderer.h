@@ -1,0 +1,86 @@
+#pragma once
+// Draws the ground (tiles of a terrain::TileTree) seen by a pinhole camera
+// into whatever framebuffer and GL context are current: the headless camera
+// and the Qt viewer share it.
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/params.h"
+#include "render/camera_model.h"
+#include "terrain/tiles.h"
+
+namespace nadir::render {
+
+struct TerrainRendererParams {
+  // GPU memory for tile meshes and textures, MiB (system memory on llvmpipe).
+  double tile_cache_mib = 512.0;
+  // Strength of the sub-imagery detail, 0..1 (contrast of the detail pattern).
+  double detail_contrast = 0.35;
+
+  void visit(core::ParamVisitor& v);
+};
+
+// What one draw needs to know about the camera.
+struct DrawView {
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  // Pinhole part only: the renderer draws undistorted images.
+  CameraIntrinsics intrinsics;
+  double near_m = 0.5;
+  double far_m = 20000.0;
+  double gain = 1.0;
+  bool ground_detail = true;
+  // Write luminance into the red channel (for gray cameras) instead of RGB.
+  bool gray = true;
+};
+
+struct DrawStats {
+  int tiles = 0;
+  int triangles = 0;
+  int tiles_uploaded = 0;
+};
+
+class TerrainRenderer {
+ public:
+  // Needs a current OpenGL 4.5 core context; keep it current for every call.
+  TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles, const TerrainRendererParams& params);
+  ~TerrainRenderer();
+  TerrainRenderer(const TerrainRenderer&) = delete;
+  TerrainRenderer& operator=(const TerrainRenderer&) = delete;
+
+  // Clears and draws into the current framebuffer (viewport = intrinsics size).
+  DrawStats draw(const DrawView& view);
+
+  // Tile selection for a view (also what draw() uses).
+  std::vector<terrain::TileId> visibleTiles(const DrawView& view);
+
+  std::size_t gpuBytes() const { return gpu_bytes_; }
+  std::size_t gpuTiles() const { return gpu_tiles_.size(); }
+  terrain::TileTree& tiles() { return *tiles_; }
+
+ private:
+  struct GpuTile;
+  GpuTile& acquire(const terrain::TileId& id, int& uploaded);
+  void evictBeyondBudget(const std::vector<terrain::TileId>& in_use);
+
+  std::shared_ptr<terrain::TileTree> tiles_;
+  TerrainRendererParams params_;
+  unsigned int program_plain_ = 0;
+  unsigned int program_detail_ = 0;
+  unsigned int index_buffer_ = 0;
+  int index_count_ = 0;
+  unsigned int detail_texture_ = 0;
+  std::unordered_map<std::uint64_t, std::unique_ptr<GpuTile>> gpu_tiles_;
+  std::list<std::uint64_t> lru_;
+  std::size_t gpu_bytes_ = 0;
+};
+
+// The frustum planes of a view, for tile selection (inward normals, world frame).
+terrain::LodView lodViewOf(const DrawView& view);
+
+}  // namespace nadir::render

@@ -1,0 +1,205 @@
+// The virtual camera against geometry worked out independently: a flat
+// checkerboard seen from a known pose lands where the pinhole model (or
+// OpenCV's projectPoints, with distortion) puts its corners.
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <Eigen/Core>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "checker_world.h"
+#include "core/frames.h"
+#include "render/camera_renderer.h"
+#include "render/egl_context.h"
+
+namespace nadir::render {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Camera pose of a body at (north, east, down) with roll/pitch/yaw carrying a down camera.
+Eigen::Isometry3d downCameraPose(const Eigen::Vector3d& p_ned, double roll, double pitch,
+                                 double yaw) {
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  T_world_cam.linear() =
+      core::rotationFromRpy({roll, pitch, yaw}) * core::rotationBodyFromDownCamera();
+  T_world_cam.translation() = p_ned;
+  return T_world_cam;
+}
+
+struct Fixture {
+  HeadlessGlContext context;
+  std::shared_ptr<test::CheckerWorld> world;
+  std::shared_ptr<terrain::TileTree> tiles;
+  std::unique_ptr<TerrainRenderer> terrain;
+
+  explicit Fixture(double ground_up_m = 0.0) {
+    world = std::make_shared<test::CheckerWorld>(9, 7, 1.0, ground_up_m);
+    terrain::TileParams tile_params;
+    tile_params.texture_px = 256;
+    tiles = std::make_shared<terrain::TileTree>(world, tile_params);
+    terrain = std::make_unique<TerrainRenderer>(tiles, TerrainRendererParams{});
+  }
+};
+
+CameraParams testCamera() {
+  CameraParams params;
+  params.width = 640;
+  params.height = 480;
+  params.hfov_deg = 70.0;
+  params.ground_detail = false;
+  return params;
+}
+
+// Largest distance from each detected corner to the nearest expected one, px.
+double worstCornerError(const std::vector<cv::Point2f>& detected,
+                        const std::vector<cv::Point2d>& expected) {
+  double worst = 0.0;
+  for (const cv::Point2f& d : detected) {
+    double best = 1e9;
+    for (const cv::Point2d& e : expected) best = std::min(best, std::hypot(d.x - e.x, d.y - e.y));
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+std::vector<Eigen::Vector3d> boardCorners(const test::CheckerWorld& world, double ground_up_m) {
+  std::vector<Eigen::Vector3d> corners;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 6; ++j)
+      corners.emplace_back(world.cornerNorth_m(i), world.cornerEast_m(j), -ground_up_m);
+  }
+  return corners;
+}
+
+std::vector<cv::Point2f> detectCorners(const cv::Mat& gray) {
+  std::vector<cv::Point2f> corners;
+  const bool found =
+      cv::findChessboardCornersSB(gray, cv::Size(6, 8), corners, cv::CALIB_CB_ACCURACY);
+  EXPECT_TRUE(found) << "the checkerboard was not found in the rendered image";
+  return corners;
+}
+
+// Board corners rendered without distortion sit within 0.5 px of the pinhole projection.
+TEST(CameraRenderer, CheckerCornersMatchPinholeProjection) {
+  Fixture fixture(3.0);
+  CameraRenderer camera(*fixture.terrain, testCamera());
+  const Eigen::Isometry3d T_world_cam =
+      downCameraPose({0.3, -0.2, -15.0}, 3.0 * kDeg, -2.0 * kDeg, 10.0 * kDeg);
+  const RenderedImage frame = camera.render(T_world_cam, 0);
+  ASSERT_EQ(frame.image.type(), CV_8UC1);
+  ASSERT_EQ(frame.image.cols, 640);
+
+  const CameraIntrinsics& k = camera.intrinsics();
+  std::vector<cv::Point2d> expected;
+  for (const Eigen::Vector3d& p_world : boardCorners(*fixture.world, 3.0)) {
+    const Eigen::Vector3d p_cam = T_world_cam.inverse() * p_world;
+    // Pinhole by hand: u = fx x/z + cx, v = fy y/z + cy.
+    expected.emplace_back(k.fx * p_cam.x() / p_cam.z() + k.cx, k.fy * p_cam.y() / p_cam.z() + k.cy);
+  }
+  const std::vector<cv::Point2f> detected = detectCorners(frame.image);
+  ASSERT_EQ(detected.size(), 48u);
+  EXPECT_LT(worstCornerError(detected, expected), 0.5);
+}
+
+// With Brown-Conrady distortion on, corners sit within 0.5 px of cv::projectPoints.
+TEST(CameraRenderer, DistortedCornersMatchOpenCvProjectPoints) {
+  Fixture fixture;
+  CameraParams params = testCamera();
+  params.distortion = {-0.28, 0.09, 0.0012, -0.0008, -0.012};
+  CameraRenderer camera(*fixture.terrain, params);
+  const Eigen::Isometry3d T_world_cam =
+      downCameraPose({-0.4, 0.5, -12.0}, -2.0 * kDeg, 4.0 * kDeg, -25.0 * kDeg);
+  const RenderedImage frame = camera.render(T_world_cam, 0);
+
+  const CameraIntrinsics& k = camera.intrinsics();
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  std::vector<cv::Point3d> object_points;
+  for (const Eigen::Vector3d& p : boardCorners(*fixture.world, 0.0))
+    object_points.emplace_back(p.x(), p.y(), p.z());
+  cv::Mat R_cam_world, rvec, tvec;
+  cv::eigen2cv(Eigen::Matrix3d(T_cam_world.rotation()), R_cam_world);
+  cv::Rodrigues(R_cam_world, rvec);
+  cv::eigen2cv(Eigen::Vector3d(T_cam_world.translation()), tvec);
+  const cv::Matx33d camera_matrix(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(object_points, rvec, tvec, camera_matrix, params.distortion, expected);
+
+  const std::vector<cv::Point2f> detected = detectCorners(frame.image);
+  ASSERT_EQ(detected.size(), 48u);
+  EXPECT_LT(worstCornerError(detected, expected), 0.5);
+}
+
+// The same pose renders the same bytes, also from a second renderer; noise follows the utime.
+TEST(CameraRenderer, RendersAreBitIdentical) {
+  CameraParams params = testCamera();
+  params.ground_detail = true;
+  params.read_noise_counts = 2.0;
+  params.shot_noise_electrons_per_count = 4.0;
+  const Eigen::Isometry3d T_world_cam = downCameraPose({1.0, 2.0, -8.0}, 0.1, -0.05, 0.3);
+  cv::Mat first, second, third;
+  {
+    Fixture fixture;
+    CameraRenderer camera(*fixture.terrain, params);
+    first = camera.render(T_world_cam, 1'000'000).image.clone();
+    second = camera.render(T_world_cam, 1'000'000).image.clone();
+    third = camera.render(T_world_cam, 1'033'333).image.clone();
+  }
+  Fixture again;
+  CameraRenderer camera(*again.terrain, params);
+  const cv::Mat fresh = camera.render(T_world_cam, 1'000'000).image;
+  EXPECT_EQ(cv::norm(first, second, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(first, fresh, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(first, third, cv::NORM_L1), 0.0) << "noise did not change with the frame time";
+}
+
+// Per-pixel depth equals the distance along the optical axis to the flat ground.
+TEST(CameraRenderer, DepthIsDistanceAlongOpticalAxis) {
+  Fixture fixture(2.0);
+  CameraRenderer camera(*fixture.terrain, testCamera());
+  const Eigen::Isometry3d T_world_cam = downCameraPose({0.0, 0.0, -20.0}, 10.0 * kDeg, 0.0, 0.0);
+  const RenderedImage frame = camera.render(T_world_cam, 0, true);
+  ASSERT_EQ(frame.depth_m.type(), CV_32FC1);
+  const CameraIntrinsics& k = camera.intrinsics();
+  // Ground plane down = -2: along the ray through pixel (u, v), depth z solves
+  // (p_cam_world + z R (x, y, 1)).down = -2 with x = (u - cx)/fx, y = (v - cy)/fy.
+  const Eigen::Matrix3d R = T_world_cam.rotation();
+  for (const auto& [u, v] :
+       std::vector<std::pair<int, int>>{{320, 240}, {10, 10}, {600, 450}, {100, 400}}) {
+    const Eigen::Vector3d ray = R * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+    const double z = (-2.0 - T_world_cam.translation().z()) / ray.z();
+    EXPECT_NEAR(frame.depth_m.at<float>(v, u), z, 0.01 * z) << "pixel " << u << ", " << v;
+  }
+}
+
+// The GPU tile cache stays within its budget while flying over many tiles.
+TEST(CameraRenderer, TileCacheRespectsItsBudget) {
+  HeadlessGlContext context;
+  auto world = std::make_shared<test::CheckerWorld>(9, 7, 1.0);
+  terrain::TileParams tile_params;
+  tile_params.texture_px = 64;
+  auto tiles = std::make_shared<terrain::TileTree>(world, tile_params);
+  TerrainRendererParams params;
+  params.tile_cache_mib = 16;
+  TerrainRenderer terrain(tiles, params);
+  CameraParams camera_params = testCamera();
+  camera_params.width = 160;
+  camera_params.height = 120;
+  CameraRenderer camera(terrain, camera_params);
+  std::size_t most = 0;
+  for (int i = 0; i < 60; ++i) {
+    const RenderedImage frame =
+        camera.render(downCameraPose({-150.0 + 5.0 * i, 20.0, -3.0}, 0, 0, 0), i);
+    most = std::max(most, terrain.gpuBytes());
+    EXPECT_LE(terrain.gpuBytes(), 16u * 1024 * 1024) << "frame " << i;
+  }
+  EXPECT_GT(most, 8u * 1024 * 1024) << "the flight should have filled the cache";
+}
+
+}  // namespace
+}  // namespace nadir::render
