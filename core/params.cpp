@@ -152,6 +152,39 @@ class YamlApplier final : public ParamVisitor {
     inner.rejectUnknownKeys();
   }
 
+  void groupMap(std::string_view key, std::string_view /*doc*/,
+                const GroupMapAccess& access) override {
+    known_.emplace_back(key);
+    const YAML::Node node = map_[std::string(key)];
+    if (!node) return;
+    const std::string full_key = joinKey(prefix_, key);
+    if (!node.IsMap()) fail(whereIs(node), full_key, "expected a map of named entries");
+    const std::vector<std::string> existing = access.names();
+    std::vector<std::string> seen;
+    for (const auto& entry : node) {
+      const std::string name = entry.first.as<std::string>();
+      const std::string entry_key = joinKey(full_key, name);
+      if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+        fail(whereIs(entry.first), entry_key, "given twice");
+      }
+      seen.push_back(name);
+      if (!entry.second.IsMap())
+        fail(whereIs(entry.second), entry_key, "expected a map of its fields");
+      const bool is_new = std::find(existing.begin(), existing.end(), name) == existing.end();
+      access.add(name);
+      YamlApplier inner(entry.second, source_, entry_key, with_lines_, dry_run_);
+      try {
+        access.visit(name, inner);
+        inner.rejectUnknownKeys();
+      } catch (...) {
+        if (is_new) access.remove(name);
+        throw;
+      }
+      // A dry run leaves no trace, not even the entries it had to create.
+      if (dry_run_ && is_new) access.remove(name);
+    }
+  }
+
   void rejectUnknownKeys() const {
     std::vector<std::string> seen;
     for (const auto& entry : map_) {
@@ -212,6 +245,13 @@ class Validator final : public ParamVisitor {
     Validator inner(source_, joinKey(prefix_, key));
     visit_members(inner);
   }
+  void groupMap(std::string_view key, std::string_view /*doc*/,
+                const GroupMapAccess& access) override {
+    for (const std::string& name : access.names()) {
+      Validator inner(source_, joinKey(joinKey(prefix_, key), name));
+      access.visit(name, inner);
+    }
+  }
 
  private:
   std::string source_;
@@ -233,6 +273,17 @@ class Formatter final : public ParamVisitor {
     out_ << "\n";
     Formatter inner(out_, indent_ + 2);
     visit_members(inner);
+  }
+  void groupMap(std::string_view key, std::string_view doc, const GroupMapAccess& access) override {
+    out_ << std::string(static_cast<std::size_t>(indent_), ' ') << key << ":";
+    if (!doc.empty()) out_ << "  # " << doc;
+    const std::vector<std::string> names = access.names();
+    out_ << (names.empty() ? " {}\n" : "\n");
+    for (const std::string& name : names) {
+      out_ << std::string(static_cast<std::size_t>(indent_ + 2), ' ') << name << ":\n";
+      Formatter inner(out_, indent_ + 4);
+      access.visit(name, inner);
+    }
   }
 
  private:

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -43,6 +44,15 @@ struct ParamSpec {
 using ParamRef =
     std::variant<bool*, int*, std::int64_t*, double*, std::string*, std::vector<double>*>;
 
+// Access to a map of named entries of one params struct (see visitGroupMap).
+struct GroupMapAccess {
+  std::function<std::vector<std::string>()> names;
+  // Adds a default entry under name (no-op if present).
+  std::function<void(const std::string& name)> add;
+  std::function<void(const std::string& name)> remove;
+  std::function<void(const std::string& name, class ParamVisitor&)> visit;
+};
+
 class ParamVisitor {
  public:
   virtual ~ParamVisitor() = default;
@@ -50,6 +60,9 @@ class ParamVisitor {
   // A nested struct under key; visit_members lists its fields.
   virtual void group(std::string_view key, std::string_view doc,
                      const std::function<void(ParamVisitor&)>& visit_members) = 0;
+  // A map of named structs under key: YAML `key: {name: {...}, other: {...}}`.
+  virtual void groupMap(std::string_view key, std::string_view doc,
+                        const GroupMapAccess& access) = 0;
 };
 
 using VisitParams = std::function<void(ParamVisitor&)>;
@@ -58,6 +71,25 @@ using VisitParams = std::function<void(ParamVisitor&)>;
 template <class P>
 void visitGroup(ParamVisitor& visitor, std::string_view key, std::string_view doc, P& params) {
   visitor.group(key, doc, [&params](ParamVisitor& inner) { params.visit(inner); });
+}
+
+// Nests a map of named params structs P under key; entries named in YAML are
+// added with P's defaults, then their fields applied.
+template <class P>
+void visitGroupMap(ParamVisitor& visitor, std::string_view key, std::string_view doc,
+                   std::map<std::string, P>& entries) {
+  GroupMapAccess access;
+  access.names = [&entries] {
+    std::vector<std::string> names;
+    for (const auto& entry : entries) names.push_back(entry.first);
+    return names;
+  };
+  access.add = [&entries](const std::string& name) { entries.try_emplace(name); };
+  access.remove = [&entries](const std::string& name) { entries.erase(name); };
+  access.visit = [&entries](const std::string& name, ParamVisitor& inner) {
+    entries.at(name).visit(inner);
+  };
+  visitor.groupMap(key, doc, access);
 }
 
 // Applies a YAML map to the fields. source names the file in errors.

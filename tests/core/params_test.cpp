@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -566,6 +567,61 @@ TEST(ParamsYaml, BadDocumentChangesNothing) {
   EXPECT_THROW(applyText(params, "name: changed\nmax_speed: 3\nmax_sped: 4\n"), ParamError);
   EXPECT_EQ(params.name, "rover");
   EXPECT_EQ(params.max_speed, 2.0);
+}
+
+struct RigParams {
+  std::map<std::string, CameraParams> cameras;
+  void visit(ParamVisitor& v) { visitGroupMap(v, "cameras", "cameras by name", cameras); }
+};
+
+VisitParams visitorOf(RigParams& params) {
+  return [&params](ParamVisitor& v) { params.visit(v); };
+}
+
+// A map of named groups: entries are created with defaults, then their fields applied.
+TEST(ParamsGroupMap, NamedEntriesAreCreatedAndFilled) {
+  RigParams rig;
+  applyYamlText("cameras:\n  down:\n    fps: 31\n  ppa:\n    width: 256\n", "rig.yaml",
+                visitorOf(rig));
+  ASSERT_EQ(rig.cameras.size(), 2u);
+  EXPECT_EQ(rig.cameras.at("down").fps, 31.0);
+  EXPECT_EQ(rig.cameras.at("down").width, 640);
+  EXPECT_EQ(rig.cameras.at("ppa").width, 256);
+  EXPECT_EQ(rig.cameras.at("ppa").fps, 30.0);
+  applyAssignment("cameras.ppa.fps=200", "--set", visitorOf(rig));
+  EXPECT_EQ(rig.cameras.at("ppa").fps, 200.0);
+  applyAssignment("cameras.side.width=100", "--set", visitorOf(rig));
+  EXPECT_EQ(rig.cameras.at("side").width, 100);
+}
+
+// An error inside one entry names the entry's key path and leaves no new entry behind.
+TEST(ParamsGroupMap, ErrorsNameTheEntryAndChangeNothing) {
+  RigParams rig;
+  EXPECT_TRUE(startsWith(paramErrorOf([&] {
+                           applyYamlText("cameras:\n  down:\n    fps: 31\n  ppa:\n    fsp: 2\n",
+                                         "rig.yaml", visitorOf(rig));
+                         }),
+                         "rig.yaml:5: cameras.ppa.fsp: unknown key"));
+  EXPECT_TRUE(rig.cameras.empty());
+  EXPECT_TRUE(startsWith(paramErrorOf([&] {
+                           applyYamlText("cameras:\n  down: {}\n  down: {}\n", "rig.yaml",
+                                         visitorOf(rig));
+                         }),
+                         "rig.yaml:3: cameras.down: given twice"));
+  EXPECT_TRUE(rig.cameras.empty());
+}
+
+// Formatted named groups read back to the same entries and values.
+TEST(ParamsGroupMap, FormatRoundTrip) {
+  RigParams rig;
+  rig.cameras["down"].fps = 31.0;
+  rig.cameras["ppa"].width = 256;
+  RigParams copy;
+  applyYamlText(formatParamsOf(rig), "formatted", visitorOf(copy));
+  ASSERT_EQ(copy.cameras.size(), 2u);
+  EXPECT_EQ(copy.cameras.at("down").fps, 31.0);
+  EXPECT_EQ(copy.cameras.at("ppa").width, 256);
+  EXPECT_EQ(formatParamsOf(copy), formatParamsOf(rig));
 }
 
 }  // namespace
