@@ -1,0 +1,70 @@
+#pragma once
+// The camera node's algorithm: one or more virtual cameras mounted on a body,
+// each rendering at its own frame rate in message time from the body's true
+// pose. No LCM here: main.cpp feeds poses in and sends the frames out.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/params.h"
+#include "render/camera_renderer.h"
+#include "render/terrain_renderer.h"
+
+namespace nadir::camera {
+
+struct CameraSpec {
+  render::CameraParams camera;
+  std::string channel = "CAMERA_DOWN";
+  std::string info_channel = "CAMERA_DOWN_INFO";
+  double fps = 31.0;
+  // Camera optical centre in the body FRD frame, m.
+  std::vector<double> mount_position_m = {0.0, 0.0, 0.0};
+  // Mount rotation relative to looking straight down with the image top towards the
+  // nose, as roll, pitch, yaw in deg (body axes, Z-Y-X).
+  std::vector<double> mount_rpy_deg = {0.0, 0.0, 0.0};
+  // 0 sends raw pixels; 1-100 sends JPEG of that quality (for thin links).
+  int jpeg_quality = 0;
+
+  void visit(core::ParamVisitor& v);
+  Eigen::Isometry3d T_body_cam() const;
+};
+
+struct CameraFrame {
+  std::string name;
+  const CameraSpec* spec = nullptr;
+  render::RenderedImage rendered;
+};
+
+class CameraRig {
+ public:
+  // Needs a current GL context for its whole life.
+  CameraRig(render::TerrainRenderer& terrain, const std::map<std::string, CameraSpec>& cameras);
+
+  // A true pose of the body at utime (message time). Returns the frames that
+  // fell due: a camera at f frames/s renders at the first pose at or after each
+  // multiple of 1/f s, stamped with that pose's utime.
+  std::vector<CameraFrame> onPose(std::int64_t utime, const Eigen::Isometry3d& T_world_body);
+
+  // Forget frame timing (after a jump back in time, e.g. a log restarted).
+  void reset();
+
+  const std::map<std::string, CameraSpec>& cameras() const { return specs_; }
+  const render::CameraIntrinsics& intrinsics(const std::string& name) const;
+
+ private:
+  struct Camera {
+    std::unique_ptr<render::CameraRenderer> renderer;
+    std::int64_t period_us = 0;
+    std::int64_t next_due_utime = -1;
+  };
+  std::map<std::string, CameraSpec> specs_;
+  std::map<std::string, Camera> cameras_;
+  std::int64_t last_utime_ = -1;
+};
+
+}  // namespace nadir::camera
