@@ -59,6 +59,32 @@ void main() {
 }
 )";
 
+constexpr const char* kTargetVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 local_ned;
+layout(location = 1) in vec2 uv;
+uniform mat4 u_clip_from_local;
+out vec2 v_uv;
+void main() {
+  gl_Position = u_clip_from_local * vec4(local_ned, 1.0);
+  v_uv = uv;
+}
+)";
+
+constexpr const char* kTargetFragmentShader = R"(#version 450 core
+in vec2 v_uv;
+uniform sampler2D u_texture;
+uniform float u_gain;
+uniform bool u_gray;
+out vec4 out_colour;
+void main() {
+  vec3 colour = texture(u_texture, v_uv).rgb * u_gain;
+  out_colour = u_gray ? vec4(dot(colour, vec3(0.299, 0.587, 0.114)), 0.0, 0.0, 1.0) : vec4(colour, 1.0);
+}
+)";
+
+// Texture resolution of a target mat: fine enough for a camera a metre above a 1 m mat.
+constexpr int kTargetTexturePx = 1024;
+
 constexpr double kDetailRepeat1_m = 10.24;
 constexpr double kDetailRepeat2_m = 71.68;
 constexpr double kDetailAngle2_rad = 0.61;
@@ -99,6 +125,19 @@ struct TerrainRenderer::GpuTile {
   }
 };
 
+struct TerrainRenderer::GpuTarget {
+  GLuint vertex_array = 0;
+  GLuint vertex_buffer = 0;
+  GLuint texture = 0;
+  Eigen::Vector3d centre_ned;
+
+  ~GpuTarget() {
+    glDeleteTextures(1, &texture);
+    glDeleteBuffers(1, &vertex_buffer);
+    glDeleteVertexArrays(1, &vertex_array);
+  }
+};
+
 void TerrainRendererParams::visit(core::ParamVisitor& v) {
   v.field(
       "tile_cache_mib", &tile_cache_mib,
@@ -116,6 +155,7 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
       std::string("#version 450 core\n#define GROUND_DETAIL 1\n") + kFragmentShader;
   program_plain_ = linkProgram("terrain", kVertexShader, fragment_plain);
   program_detail_ = linkProgram("terrain+detail", kVertexShader, fragment_detail);
+  program_target_ = linkProgram("ground target", kTargetVertexShader, kTargetFragmentShader);
 
   // One index buffer serves every tile: the grid, then a skirt down from each
   // edge that hides cracks between tiles of different levels.
@@ -162,10 +202,90 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
 
 TerrainRenderer::~TerrainRenderer() {
   gpu_tiles_.clear();
+  targets_.clear();
+  glDeleteProgram(program_target_);
   glDeleteTextures(1, &detail_texture_);
   glDeleteBuffers(1, &index_buffer_);
   glDeleteProgram(program_plain_);
   glDeleteProgram(program_detail_);
+}
+
+void TerrainRenderer::setTargets(const std::vector<terrain::GroundTarget>& targets) {
+  targets_.clear();
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  for (const terrain::GroundTarget& target : targets) {
+    auto gpu = std::make_unique<GpuTarget>();
+    gpu->centre_ned = Eigen::Vector3d(target.north_m, target.east_m,
+                                      -tiles_->world().groundUp_m(target.north_m, target.east_m));
+    // Corners in texture order: (0,0) north-west, (1,0) north-east, (1,1), (0,1).
+    const double c = std::cos(target.yaw_deg * kDeg), s = std::sin(target.yaw_deg * kDeg);
+    const double half = 0.5 * target.size_m;
+    std::vector<float> vertices;
+    for (const auto& [u, v] : {std::pair{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}}) {
+      const double north_in_mat = half - v * target.size_m;
+      const double east_in_mat = u * target.size_m - half;
+      const double north = c * north_in_mat - s * east_in_mat;
+      const double east = s * north_in_mat + c * east_in_mat;
+      const double down = -tiles_->world().groundUp_m(target.north_m + north, target.east_m + east);
+      vertices.insert(vertices.end(), {static_cast<float>(north), static_cast<float>(east),
+                                       static_cast<float>(down - gpu->centre_ned.z()),
+                                       static_cast<float>(u), static_cast<float>(v)});
+    }
+    glGenVertexArrays(1, &gpu->vertex_array);
+    glBindVertexArray(gpu->vertex_array);
+    glGenBuffers(1, &gpu->vertex_buffer);
+    glBindBuffer(GL_ARRAY_BUFFER, gpu->vertex_buffer);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
+                 vertices.data(), GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float),
+                          reinterpret_cast<const void*>(3 * sizeof(float)));
+    glEnableVertexAttribArray(1);
+    glBindVertexArray(0);
+    const cv::Mat rgb = terrain::targetTexture(target, kTargetTexturePx);
+    glGenTextures(1, &gpu->texture);
+    glBindTexture(GL_TEXTURE_2D, gpu->texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
+                 rgb.data);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    targets_.push_back(std::move(gpu));
+  }
+  checkGl("uploading ground targets");
+}
+
+void TerrainRenderer::drawTargets(const DrawView& view, const Eigen::Matrix4d& clip_from_camera) {
+  if (targets_.empty()) return;
+  // Mats lie on the ground; the mesh may sit a little above the true ground at
+  // coarse levels, so they are drawn over the terrain without a depth test (a
+  // downward camera never has terrain between itself and a mat on the ground).
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(program_target_);
+  glUniform1f(glGetUniformLocation(program_target_, "u_gain"), static_cast<float>(view.gain));
+  glUniform1i(glGetUniformLocation(program_target_, "u_gray"), view.gray ? 1 : 0);
+  glUniform1i(glGetUniformLocation(program_target_, "u_texture"), 0);
+  const GLint clip_from_local = glGetUniformLocation(program_target_, "u_clip_from_local");
+  const Eigen::Matrix3d R_cam_world = view.T_world_cam.rotation().transpose();
+  for (const auto& target : targets_) {
+    Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
+    camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
+    camera_from_local.topRightCorner<3, 1>() =
+        R_cam_world * (target->centre_ned - view.T_world_cam.translation());
+    // Behind the camera: nothing to draw (and the projection would mirror it).
+    if (camera_from_local(2, 3) <= view.near_m) continue;
+    const Eigen::Matrix4f clip = (clip_from_camera * camera_from_local).cast<float>();
+    glUniformMatrix4fv(clip_from_local, 1, GL_FALSE, clip.data());
+    glBindTexture(GL_TEXTURE_2D, target->texture);
+    glBindVertexArray(target->vertex_array);
+    glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  }
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
 }
 
 terrain::LodView lodViewOf(const DrawView& view) {
@@ -329,6 +449,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
     stats.triangles += index_count_ / 3;
   }
   glBindVertexArray(0);
+  drawTargets(view, P);
   evictBeyondBudget(visible);
   checkGl("drawing the terrain");
   return stats;

@@ -13,6 +13,7 @@
 
 #include "core/params.h"
 #include "render/camera_model.h"
+#include "terrain/targets.h"
 #include "terrain/tiles.h"
 
 namespace nadir::render {
@@ -56,6 +57,9 @@ class TerrainRenderer {
   // Clears and draws into the current framebuffer (viewport = intrinsics size).
   DrawStats draw(const DrawView& view);
 
+  // Ground targets drawn on top of the terrain from now on (replacing earlier ones).
+  void setTargets(const std::vector<terrain::GroundTarget>& targets);
+
   // Tile selection for a view (also what draw() uses).
   std::vector<terrain::TileId> visibleTiles(const DrawView& view);
 
@@ -75,6 +79,10 @@ class TerrainRenderer {
   unsigned int index_buffer_ = 0;
   int index_count_ = 0;
   unsigned int detail_texture_ = 0;
+  struct GpuTarget;
+  void drawTargets(const DrawView& view, const Eigen::Matrix4d& clip_from_camera);
+  unsigned int program_target_ = 0;
+  std::vector<std::unique_ptr<GpuTarget>> targets_;
   std::unordered_map<std::uint64_t, std::unique_ptr<GpuTile>> gpu_tiles_;
   std::list<std::uint64_t> lru_;
   std::size_t gpu_bytes_ = 0;

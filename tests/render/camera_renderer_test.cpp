@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "checker_world.h"
 #include "core/frames.h"
@@ -175,6 +176,39 @@ TEST(CameraRenderer, DepthIsDistanceAlongOpticalAxis) {
     const double z = (-2.0 - T_world_cam.translation().z()) / ray.z();
     EXPECT_NEAR(frame.depth_m.at<float>(v, u), z, 0.01 * z) << "pixel " << u << ", " << v;
   }
+}
+
+// A concentric ground target appears where it lies, with all its rings: along the row
+// through its centre, 5 rings give 10 dark runs, and the dark pixels centre on its projection.
+TEST(CameraRenderer, ConcentricTargetIsDrawnWithItsRings) {
+  Fixture fixture(1.0);
+  terrain::GroundTarget target;
+  target.north_m = 100.0;
+  target.east_m = 80.0;
+  target.size_m = 1.0;
+  target.rings = 5;
+  target.yaw_deg = 0.0;
+  fixture.terrain->setTargets({target});
+  CameraRenderer camera(*fixture.terrain, testCamera());
+  const Eigen::Isometry3d T_world_cam = downCameraPose({100.05, 79.9, -3.0}, 0.0, 0.0, 0.0);
+  const cv::Mat image = camera.render(T_world_cam, 0).image;
+  const Eigen::Vector3d centre_cam = T_world_cam.inverse() * Eigen::Vector3d(100.0, 80.0, -1.0);
+  const Eigen::Vector2d centre_px = camera.intrinsics().project(centre_cam);
+  const int row = static_cast<int>(std::lround(centre_px.y()));
+  int dark_runs = 0;
+  for (int col = 1; col < image.cols; ++col) {
+    if (image.at<std::uint8_t>(row, col) < 70 && image.at<std::uint8_t>(row, col - 1) >= 70)
+      ++dark_runs;
+  }
+  EXPECT_EQ(dark_runs, 10);
+  // Darkness below the gray background as weights: anti-aliased ring edges count
+  // in proportion, so the centroid is sub-pixel.
+  cv::Mat darkness;
+  cv::subtract(cv::Scalar(128), image, darkness);
+  const cv::Moments m = cv::moments(darkness, false);
+  ASSERT_GT(m.m00, 1000.0);
+  EXPECT_NEAR(m.m10 / m.m00, centre_px.x(), 0.5);
+  EXPECT_NEAR(m.m01 / m.m00, centre_px.y(), 0.5);
 }
 
 // The GPU tile cache stays within its budget while flying over many tiles.

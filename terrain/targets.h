@@ -1,0 +1,36 @@
+#pragma once
+// Ground targets: printed mats laid on the ground at known positions, drawn
+// into the camera images at far finer resolution than the terrain imagery.
+//  - concentric: nested black square rings on white (seed 000's target, found
+//    by flooding from the border and inverting N times);
+//  - gate: four black disks inside two concentric black squares (seed 001).
+
+#include <string>
+
+#include <opencv2/core/mat.hpp>
+
+#include "core/params.h"
+
+namespace nadir::terrain {
+
+struct GroundTarget {
+  // "concentric" or "gate".
+  std::string kind = "concentric";
+  // Centre in the world frame (local NED), m.
+  double north_m = 0.0;
+  double east_m = 0.0;
+  // Edge length of the square mat, m.
+  double size_m = 1.0;
+  // Rotation of the mat about the down axis, from north towards east, deg.
+  double yaw_deg = 0.0;
+  // Concentric: black rings, each two boundaries.
+  int rings = 5;
+
+  void visit(core::ParamVisitor& v);
+};
+
+// The mat as an 8-bit RGB image (CV_8UC3), size_px square, row 0 at the mat's
+// north edge when yaw is 0. Edges are area-averaged (anti-aliased).
+cv::Mat targetTexture(const GroundTarget& target, int size_px);
+
+}  // namespace nadir::terrain
