@@ -8,6 +8,7 @@ find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
 pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib)
 pkg_check_modules(YAMLCPP REQUIRED IMPORTED_TARGET yaml-cpp)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
+pkg_check_modules(LIBTIFF REQUIRED IMPORTED_TARGET libtiff-4)
 pkg_check_modules(OPENGL REQUIRED IMPORTED_TARGET opengl)
 
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)

@@ -22,7 +22,7 @@ struct ElevationRaster {
   int height = 0;
   std::vector<float> height_m;  // row-major, row 0 north; no NaN after reading
   RasterGeoref georef;
-  std::string source;  // the file it came from
+  std::string source;    // the file it came from
   int filled_voids = 0;  // samples that were voids/nodata and were filled
 
   float at(int col, int row) const {
@@ -34,14 +34,16 @@ struct ElevationRaster {
   // footprint [-0.5, width - 0.5] x [-0.5, height - 0.5]; between the outer
   // edge and the outermost pixel centres the edge samples are used.
   std::optional<double> heightAtPixel(const PixelPoint& pixel) const;
-  // Same, but outside the footprint the nearest edge value.
+  // Same, but outside the footprint the nearest edge value (NaN for a NaN
+  // pixel).
   double heightAtPixelClamped(const PixelPoint& pixel) const;
   // Bilinear height under a geodetic position (its alt_m is ignored).
   std::optional<double> heightAt(const core::Geodetic& point) const;
 };
 
 // SRTM .hgt: big-endian int16, 1201 x 1201 (3") or 3601 x 3601 (1"); the
-// tile's south-west corner from the name (N44W072 -> 44 N, 72 W), pixel (0,0)
+// tile's south-west corner from the first N44W072-like part of the file name
+// (N44W072 -> 44 N, 72 W; S12E034 -> 12 S, 34 E), pixel (0,0)
 // centred on its north-west corner; -32768 is a void.
 ElevationRaster readSrtmHgt(const std::string& path);
 

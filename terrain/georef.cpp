@@ -1,10 +1,10 @@
 #include "terrain/georef.h"
 
+#include <tiffio.h>
 #include <GeographicLib/Constants.hpp>
-#include <GeographicLib/UTMUPS.hpp>
+#include <GeographicLib/TransverseMercator.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <tiffio.h>
 
 #include <algorithm>
 #include <array>
@@ -26,6 +26,7 @@ namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+constexpr double kUtmFalseEasting_m = 500'000.0;
 constexpr double kUtmSouthFalseNorthing_m = 10'000'000.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -46,6 +47,8 @@ constexpr int kModelTypeGeographic = 2;
 constexpr int kRasterPixelIsPoint = 2;
 constexpr int kUnitDegree = 9102;
 constexpr int kUnitMetre = 9001;
+
+double utmCentralMeridian_deg(int zone) { return 6.0 * zone - 183.0; }
 
 std::string utmName(int zone, bool north) {
   return "UTM " + std::to_string(zone) + (north ? "N" : "S");
@@ -261,32 +264,25 @@ CrsPoint Crs::fromGeodetic(const core::Geodetic& point) const {
   const double lat_deg = point.lat_rad * kDegPerRad;
   const double lon_deg = point.lon_rad * kDegPerRad;
   if (kind == Kind::kGeographic) return {lon_deg, lat_deg};
-  try {
-    int zone = 0;
-    bool north = true;
-    CrsPoint out;
-    GeographicLib::UTMUPS::Forward(lat_deg, lon_deg, zone, north, out.x, out.y, utm_zone);
-    // UTMUPS picks the hemisphere from the latitude; move to this CRS's.
-    if (north && !utm_north) out.y += kUtmSouthFalseNorthing_m;
-    if (!north && utm_north) out.y -= kUtmSouthFalseNorthing_m;
-    return out;
-  } catch (const GeographicLib::GeographicErr&) {
-    return {kNaN, kNaN};
-  }
+  if (!(std::abs(lat_deg) <= 90.0) || !std::isfinite(lon_deg)) return {kNaN, kNaN};
+  CrsPoint out;
+  GeographicLib::TransverseMercator::UTM().Forward(utmCentralMeridian_deg(utm_zone), lat_deg,
+                                                   lon_deg, out.x, out.y);
+  out.x += kUtmFalseEasting_m;
+  if (!utm_north) out.y += kUtmSouthFalseNorthing_m;
+  return out;
 }
 
 core::Geodetic Crs::toGeodetic(const CrsPoint& point, double alt_m) const {
   if (kind == Kind::kGeographic) {
     return {point.y * kRadPerDeg, point.x * kRadPerDeg, alt_m};
   }
-  try {
-    double lat_deg = 0.0;
-    double lon_deg = 0.0;
-    GeographicLib::UTMUPS::Reverse(utm_zone, utm_north, point.x, point.y, lat_deg, lon_deg);
-    return {lat_deg * kRadPerDeg, lon_deg * kRadPerDeg, alt_m};
-  } catch (const GeographicLib::GeographicErr&) {
-    return {kNaN, kNaN, alt_m};
-  }
+  double lat_deg = 0.0;
+  double lon_deg = 0.0;
+  GeographicLib::TransverseMercator::UTM().Reverse(
+      utmCentralMeridian_deg(utm_zone), point.x - kUtmFalseEasting_m,
+      point.y - (utm_north ? 0.0 : kUtmSouthFalseNorthing_m), lat_deg, lon_deg);
+  return {lat_deg * kRadPerDeg, lon_deg * kRadPerDeg, alt_m};
 }
 
 PixelGroundSize RasterGeoref::groundPixelSize(int width, int height) const {
@@ -303,11 +299,10 @@ PixelGroundSize RasterGeoref::groundPixelSize(int width, int height) const {
     return {std::abs(pixel_dx) * kRadPerDeg * prime_vertical_m * std::cos(at.lat_rad),
             std::abs(pixel_dy) * kRadPerDeg * meridional_m};
   }
-  int zone = 0;
-  bool north = true;
   double x = 0.0, y = 0.0, gamma = 0.0, scale = 1.0;
-  GeographicLib::UTMUPS::Forward(at.lat_rad * kDegPerRad, at.lon_rad * kDegPerRad, zone, north, x,
-                                 y, gamma, scale, crs.utm_zone);
+  GeographicLib::TransverseMercator::UTM().Forward(utmCentralMeridian_deg(crs.utm_zone),
+                                                   at.lat_rad * kDegPerRad, at.lon_rad * kDegPerRad,
+                                                   x, y, gamma, scale);
   return {std::abs(pixel_dx) / scale, std::abs(pixel_dy) / scale};
 }
 

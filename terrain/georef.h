@@ -56,11 +56,13 @@ struct Crs {
   int epsg() const;
   std::string name() const;  // "EPSG:4326 (WGS 84)", "EPSG:32612 (UTM 12N)"
 
-  // Geodetic -> CRS. UTM always uses this CRS's zone and hemisphere (a point
-  // outside the zone maps to an easting beyond the usual range; one too far
-  // for GeographicLib's UTMUPS gives NaN coordinates).
+  // Geodetic -> CRS. UTM always uses this CRS's zone and hemisphere, with
+  // GeographicLib's TransverseMercator::UTM() (what GeographicLib::UTMUPS
+  // computes when given the zone, but without UTMUPS's range check, so a
+  // point beyond the zone still maps, to an easting outside the usual range).
+  // NaN coordinates for a latitude beyond +-90 deg.
   CrsPoint fromGeodetic(const core::Geodetic& point) const;
-  // CRS -> geodetic with height alt_m (NaN coordinates if UTM cannot invert).
+  // CRS -> geodetic with height alt_m.
   core::Geodetic toGeodetic(const CrsPoint& point, double alt_m = 0.0) const;
 
   bool operator==(const Crs& other) const = default;

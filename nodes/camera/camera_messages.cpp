@@ -1,5 +1,6 @@
 #include "nodes/camera/camera_messages.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
@@ -81,6 +82,16 @@ cv::Mat imageFromMessage(const nadir::image_t& message) {
   if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_BGR)
     cv::cvtColor(pixels, pixels, cv::COLOR_BGR2RGB);
   return pixels;
+}
+
+Eigen::Isometry3d bodyPoseFromMessage(const nadir::pose_t& pose) {
+  for (double p : pose.pos) {
+    if (!std::isfinite(p)) throw std::invalid_argument("pose_t at utime " + std::to_string(pose.utime) + " has a non-finite position");
+  }
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  T_world_body.linear() = core::quaternionFromWire(pose.orientation).toRotationMatrix();
+  T_world_body.translation() = Eigen::Vector3d(pose.pos[0], pose.pos[1], pose.pos[2]);
+  return T_world_body;
 }
 
 nadir::camera_info_t toCameraInfo(const std::string& name, const CameraSpec& spec,
