@@ -46,10 +46,11 @@ cv::Mat makeDetailTexture() {
     for (int col = 0; col < kSize; ++col) {
       const double u = (col + 0.5) / kSize, v = (row + 0.5) / kSize;
       double sum = 0.0, amplitude = 1.0;
-      // Octaves from clumps a quarter of the tile across down to single texels.
-      for (int octave = 0; octave < 7; ++octave) {
+      // Octaves from clumps a thirty-second of the tile across (0.32 m in the
+      // first layer) down to single texels: only structure finer than the imagery.
+      for (int octave = 0; octave < 4; ++octave) {
         sum += amplitude *
-               (periodicNoise(u, v, 4 << octave, static_cast<std::uint32_t>(octave)) - 0.5);
+               (periodicNoise(u, v, 32 << octave, static_cast<std::uint32_t>(octave)) - 0.5);
         amplitude *= 0.62;
       }
       values[static_cast<std::size_t>(row) * kSize + col] = sum;

@@ -22,7 +22,7 @@ struct TerrainRendererParams {
   // GPU memory for tile meshes and textures, MiB (system memory on llvmpipe).
   double tile_cache_mib = 512.0;
   // Strength of the sub-imagery detail, 0..1 (contrast of the detail pattern).
-  double detail_contrast = 0.35;
+  double detail_contrast = 0.1;
 
   void visit(core::ParamVisitor& v);
 };

@@ -86,7 +86,9 @@ cv::Mat imageFromMessage(const nadir::image_t& message) {
 
 Eigen::Isometry3d bodyPoseFromMessage(const nadir::pose_t& pose) {
   for (double p : pose.pos) {
-    if (!std::isfinite(p)) throw std::invalid_argument("pose_t at utime " + std::to_string(pose.utime) + " has a non-finite position");
+    if (!std::isfinite(p))
+      throw std::invalid_argument("pose_t at utime " + std::to_string(pose.utime) +
+                                  " has a non-finite position");
   }
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
   T_world_body.linear() = core::quaternionFromWire(pose.orientation).toRotationMatrix();

@@ -1,0 +1,50 @@
+#pragma once
+// Builds the World a scenario or node asks for: the procedural world, or real
+// terrain from a DEM and imagery files around a geodetic origin.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/geodesy.h"
+#include "core/params.h"
+#include "terrain/procedural_world.h"
+#include "terrain/world.h"
+
+namespace nadir::terrain {
+
+struct WorldParams {
+  // "procedural" or "files".
+  std::string kind = "procedural";
+  ProceduralWorldParams procedural;
+  // files: a DEM (.hgt, GeoTIFF, ESRI .asc).
+  std::string dem_path;
+  // files: imagery as one RGB GeoTIFF, or a plain image with imagery_bounds_deg;
+  // empty with the band paths below; all empty: the DEM's shaded relief.
+  std::string imagery_path;
+  std::string imagery_red_path;
+  std::string imagery_green_path;
+  std::string imagery_blue_path;
+  // Plain image corners: north, south, west, east latitude/longitude, deg.
+  std::vector<double> imagery_bounds_deg = {0.0, 0.0, 0.0, 0.0};
+  // The world frame's origin (WGS-84, deg and m above the ellipsoid). With
+  // files and origin_at_dem_centre, the DEM's centre at its ground height.
+  double origin_lat_deg = 0.0;
+  double origin_lon_deg = 0.0;
+  double origin_alt_m = 0.0;
+  bool origin_at_dem_centre = true;
+
+  void visit(core::ParamVisitor& v);
+};
+
+struct BuiltWorld {
+  std::shared_ptr<const World> world;
+  // The geodetic origin of the world frame.
+  core::Geodetic origin;
+  std::string description;
+};
+
+// Throws TerrainError (files) or core::ParamError (bad values) naming what is wrong.
+BuiltWorld makeWorld(const WorldParams& params);
+
+}  // namespace nadir::terrain
