@@ -33,7 +33,7 @@ struct TileId {
 
 struct TileParams {
   // Mesh quads along a tile's edge.
-  int mesh_quads = 16;
+  int mesh_quads = 8;
   // Texture pixels along a tile's edge (plus one border texel each side).
   int texture_px = 512;
   // Refine while a tile's mesh error seen from the camera exceeds this, px.
