@@ -21,7 +21,7 @@ out vec2 v_uv;
 out vec2 v_detail_1;
 out vec2 v_detail_2;
 const float kDetailRepeat1_m = 10.24;
-const float kDetailRepeat2_m = 6.37;
+uniform float u_detail_repeat_2_m;
 void main() {
   gl_Position = u_clip_from_local * vec4(local_ned, 1.0);
   // Texture row 0 is the north edge; one border texel on each side.
@@ -29,7 +29,7 @@ void main() {
   v_uv = vec2((1.0 + local_ned.y / u_size_m * u_texture_px) / texels,
               (1.0 + (u_size_m - local_ned.x) / u_size_m * u_texture_px) / texels);
   v_detail_1 = (u_detail_origin_1 + local_ned.yx) / kDetailRepeat1_m;
-  v_detail_2 = (u_detail_origin_2 + u_detail_rotation_2 * local_ned.yx) / kDetailRepeat2_m;
+  v_detail_2 = (u_detail_origin_2 + u_detail_rotation_2 * local_ned.yx) / u_detail_repeat_2_m;
 }
 )";
 
@@ -92,9 +92,15 @@ void main() {
 constexpr int kTargetTexturePx = 1024;
 
 // Two layers with incommensurate repeats and a rotation between them, so the
-// pattern never visibly repeats; the shader's constants must match.
+// pattern never visibly repeats; the shader's constant must match.
 constexpr double kDetailRepeat1_m = 10.24;
-constexpr double kDetailRepeat2_m = 6.37;
+
+// The second layer scales with the world's imagery: its coarsest clumps are
+// one imagery texel, so coarse real imagery (30 m Landsat) also gets texture
+// between its texel and the first layer's.
+double detailRepeat2_m(const terrain::World& world) {
+  return std::max(6.37, 32.0 * world.imageryResolution_m());
+}
 constexpr double kDetailAngle2_rad = 0.61;
 
 double positiveMod(double value, double period) {
@@ -454,6 +460,8 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
     const float rotation_2[4] = {c2, s2, -s2, c2};  // column-major
     glUniformMatrix2fv(glGetUniformLocation(program, "u_detail_rotation_2"), 1, GL_FALSE,
                        rotation_2);
+    const double repeat_2_m = detailRepeat2_m(tiles_->world());
+    glUniform1f(glGetUniformLocation(program, "u_detail_repeat_2_m"), static_cast<float>(repeat_2_m));
     for (const terrain::TileId& id : *ids) {
       GpuTile& tile = acquire(id, stats.tiles_uploaded);
       // Camera-relative in double, then float: full precision near the camera.
@@ -470,8 +478,8 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
                   static_cast<float>(positiveMod(north, kDetailRepeat1_m)));
       const double c = std::cos(kDetailAngle2_rad), s = std::sin(kDetailAngle2_rad);
       glUniform2f(detail_origin_2,
-                  static_cast<float>(positiveMod(c * east - s * north, kDetailRepeat2_m)),
-                  static_cast<float>(positiveMod(s * east + c * north, kDetailRepeat2_m)));
+                  static_cast<float>(positiveMod(c * east - s * north, repeat_2_m)),
+                  static_cast<float>(positiveMod(s * east + c * north, repeat_2_m)));
       glBindTexture(GL_TEXTURE_2D, tile.texture);
       glBindVertexArray(tile.vertex_array);
       glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);

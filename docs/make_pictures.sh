@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Renders the pictures in docs/images with `nadir snapshot`: what the 1280x960
+# downward camera sees at 10, 50 and 300 m above ground over the procedural
+# world and over Zion National Park (SRTM DEM, Landsat 8 imagery at 30 m).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+nadir="$root/build/bin/nadir"
+data="$root/tests/data/terrain"
+out="$root/docs/images"
+mkdir -p "$out"
+common=(--set camera.pixel_format=rgb8 --set yaw_deg=20)
+zion=(--set world.kind=files --set "world.dem_path=$data/zion_srtm.tif"
+      --set "world.imagery_red_path=$data/zion_landsat_b4.tif"
+      --set "world.imagery_green_path=$data/zion_landsat_b3.tif"
+      --set "world.imagery_blue_path=$data/zion_landsat_b2.tif")
+"$nadir" snapshot "${common[@]}" "${zion[@]}" --set agl_m=3000 --out "$out/zion_3000m.png"
+for agl in 10 50 300; do
+  "$nadir" snapshot "${common[@]}" --set agl_m=$agl --set north_m=-180 --set east_m=260 \
+    --out "$out/procedural_${agl}m.png"
+  "$nadir" snapshot "${common[@]}" "${zion[@]}" --set agl_m=$agl --out "$out/zion_${agl}m.png"
+done
