@@ -2,6 +2,7 @@
 
 #include <lcm/lcm.h>
 
+#include <cerrno>
 #include <string>
 #include <utility>
 
@@ -40,6 +41,8 @@ void LcmBus::publish(std::string_view channel, const void* data, std::size_t siz
 bool LcmBus::handle(std::chrono::milliseconds timeout) {
   const int status = lcm_handle_timeout(lcm_, static_cast<int>(timeout.count()));
   if (pending_) std::rethrow_exception(std::exchange(pending_, nullptr));
+  // A signal (Ctrl-C) interrupting the wait is not a failure: nothing arrived.
+  if (status < 0 && errno == EINTR) return false;
   if (status < 0) throw BusError("LCM failed while waiting for messages on " + url_);
   return status > 0;
 }
