@@ -103,6 +103,22 @@ double detailRepeat2_m(const terrain::World& world) {
 }
 constexpr double kDetailAngle2_rad = 0.61;
 
+// An 8-bit RGB image as a mipmapped, edge-clamped texture.
+GLuint uploadRgbTexture(const cv::Mat& rgb, GLenum min_filter) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
+               rgb.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(min_filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return texture;
+}
+
 double positiveMod(double value, double period) {
   const double r = std::fmod(value, period);
   return r < 0.0 ? r + period : r;
@@ -257,17 +273,8 @@ void TerrainRenderer::setTargets(const std::vector<terrain::GroundTarget>& targe
                           reinterpret_cast<const void*>(3 * sizeof(float)));
     glEnableVertexAttribArray(1);
     glBindVertexArray(0);
-    const cv::Mat rgb = terrain::targetTexture(target, kTargetTexturePx);
-    glGenTextures(1, &gpu->texture);
-    glBindTexture(GL_TEXTURE_2D, gpu->texture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
-                 rgb.data);
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gpu->texture =
+        uploadRgbTexture(terrain::targetTexture(target, kTargetTexturePx), GL_LINEAR_MIPMAP_LINEAR);
     targets_.push_back(std::move(gpu));
   }
   checkGl("uploading ground targets");
@@ -372,18 +379,9 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
   glBindVertexArray(0);
 
   const cv::Mat rgb = tiles_->imagery(id);
-  glGenTextures(1, &tile->texture);
-  glBindTexture(GL_TEXTURE_2D, tile->texture);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
-               rgb.data);
-  glGenerateMipmap(GL_TEXTURE_2D);
-  // Nearest mip level, bilinear within it: a third cheaper than trilinear on
-  // llvmpipe, and the tile choice keeps the level near 0 (a texel about a pixel).
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // Nearest mip level, bilinear within it: cheaper than trilinear on llvmpipe,
+  // and the tile choice keeps the level near 0 (a texel about a pixel).
+  tile->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_NEAREST);
   tile->bytes =
       vertices.size() * sizeof(float) + static_cast<std::size_t>(rgb.cols) * rgb.rows * 4 * 4 / 3;
   gpu_bytes_ += tile->bytes;
@@ -461,7 +459,8 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
     glUniformMatrix2fv(glGetUniformLocation(program, "u_detail_rotation_2"), 1, GL_FALSE,
                        rotation_2);
     const double repeat_2_m = detailRepeat2_m(tiles_->world());
-    glUniform1f(glGetUniformLocation(program, "u_detail_repeat_2_m"), static_cast<float>(repeat_2_m));
+    glUniform1f(glGetUniformLocation(program, "u_detail_repeat_2_m"),
+                static_cast<float>(repeat_2_m));
     for (const terrain::TileId& id : *ids) {
       GpuTile& tile = acquire(id, stats.tiles_uploaded);
       // Camera-relative in double, then float: full precision near the camera.
