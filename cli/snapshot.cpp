@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <numbers>
 
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +12,7 @@
 #include "core/params.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
+#include "terrain/targets.h"
 #include "terrain/world_factory.h"
 
 namespace nadir::cli {
@@ -21,6 +23,7 @@ struct SnapshotParams {
   terrain::TileParams tiles;
   render::TerrainRendererParams renderer;
   render::CameraParams camera;
+  std::map<std::string, terrain::GroundTarget> targets;
   double north_m = 0.0;
   double east_m = 0.0;
   double agl_m = 300.0;
@@ -33,6 +36,7 @@ struct SnapshotParams {
     core::visitGroup(v, "tiles", "terrain tiles and levels of detail", tiles);
     core::visitGroup(v, "renderer", "terrain drawing", renderer);
     core::visitGroup(v, "camera", "the camera, looking down from the body", camera);
+    core::visitGroupMap(v, "targets", "ground targets by name", targets);
     v.field("north_m", &north_m,
             {.doc = "body position north of the origin, m", .min = -1e6, .max = 1e6});
     v.field("east_m", &east_m,
@@ -57,6 +61,10 @@ int runSnapshot(const std::string& config_path, const std::vector<std::string>& 
   render::HeadlessGlContext context;
   auto tiles = std::make_shared<terrain::TileTree>(built.world, params.tiles);
   render::TerrainRenderer terrain(tiles, params.renderer);
+  std::vector<terrain::GroundTarget> targets;
+  for (const auto& [name, target] : params.targets) targets.push_back(target);
+  terrain::resolveGeodeticTargets(targets, core::LocalNedFrame(built.origin));
+  terrain.setTargets(targets);
   render::CameraRenderer camera(terrain, params.camera);
 
   constexpr double kDeg = std::numbers::pi / 180.0;

@@ -37,11 +37,26 @@ void GroundTarget::visit(core::ParamVisitor& v) {
   v.field("kind", &kind, {.doc = "concentric or gate", .choices = {"concentric", "gate"}});
   v.field("north_m", &north_m, {.doc = "centre north of the origin, m", .min = -1e6, .max = 1e6});
   v.field("east_m", &east_m, {.doc = "centre east of the origin, m", .min = -1e6, .max = 1e6});
+  v.field("geodetic", &geodetic, {.doc = "place by lat_deg/lon_deg instead of north_m/east_m"});
+  v.field("lat_deg", &lat_deg,
+          {.doc = "centre latitude (WGS-84), deg, with geodetic", .min = -90, .max = 90});
+  v.field("lon_deg", &lon_deg,
+          {.doc = "centre longitude, deg, with geodetic", .min = -180, .max = 180});
   v.field("size_m", &size_m, {.doc = "edge length of the mat, m", .min = 0.05, .max = 100});
   v.field("yaw_deg", &yaw_deg,
           {.doc = "rotation from north towards east, deg", .min = -360, .max = 360});
   v.field("rings", &rings,
           {.doc = "concentric: black rings (two boundaries each)", .min = 1, .max = 50});
+}
+
+void resolveGeodeticTargets(std::vector<GroundTarget>& targets, const core::LocalNedFrame& frame) {
+  for (GroundTarget& target : targets) {
+    if (!target.geodetic) continue;
+    const Eigen::Vector3d p_ned = frame.nedFromGeodetic(
+        core::geodeticFromDegrees(target.lat_deg, target.lon_deg, frame.origin().alt_m));
+    target.north_m = p_ned.x();
+    target.east_m = p_ned.y();
+  }
 }
 
 cv::Mat targetTexture(const GroundTarget& target, int size_px) {

@@ -53,4 +53,11 @@ class World {
   virtual WorldExtent extent() const = 0;
 };
 
+// Height of a point (world frame, NED) above the ground below it, m: what a
+// rangefinder pointing straight down would read on level flight.
+inline double heightAboveGround_m(const World& world, double north_m, double east_m,
+                                  double down_m) {
+  return -down_m - world.groundUp_m(north_m, east_m);
+}
+
 }  // namespace nadir::terrain

@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
     nadir::render::TerrainRenderer terrain(tiles, params.renderer);
     std::vector<nadir::terrain::GroundTarget> targets;
     for (const auto& [name, target] : params.targets) targets.push_back(target);
+    nadir::terrain::resolveGeodeticTargets(targets, nadir::core::LocalNedFrame(built.origin));
     terrain.setTargets(targets);
     nadir::camera::CameraRig rig(terrain, params.cameras);
 
