@@ -10,8 +10,8 @@
 
 #include "core/frames.h"
 #include "core/params.h"
+#include "nodes/camera/ground_scene.h"
 #include "render/camera_renderer.h"
-#include "render/egl_context.h"
 #include "terrain/targets.h"
 #include "terrain/world_factory.h"
 
@@ -57,15 +57,9 @@ int runSnapshot(const std::string& config_path, const std::vector<std::string>& 
   if (!config_path.empty()) core::applyYamlFile(config_path, visit);
   core::applyAssignments(params, overrides);
 
-  const terrain::BuiltWorld built = terrain::makeWorld(params.world);
-  render::HeadlessGlContext context;
-  auto tiles = std::make_shared<terrain::TileTree>(built.world, params.tiles);
-  render::TerrainRenderer terrain(tiles, params.renderer);
-  std::vector<terrain::GroundTarget> targets;
-  for (const auto& [name, target] : params.targets) targets.push_back(target);
-  terrain::resolveGeodeticTargets(targets, core::LocalNedFrame(built.origin));
-  terrain.setTargets(targets);
-  render::CameraRenderer camera(terrain, params.camera);
+  camera::GroundScene scene(params.world, params.tiles, params.renderer, params.targets);
+  const terrain::BuiltWorld& built = scene.built;
+  render::CameraRenderer camera(scene.terrain, params.camera);
 
   constexpr double kDeg = std::numbers::pi / 180.0;
   const double ground_up_m = built.world->groundUp_m(params.north_m, params.east_m);

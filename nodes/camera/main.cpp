@@ -14,8 +14,7 @@
 #include "nodes/camera/camera_messages.h"
 #include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
-#include "render/egl_context.h"
-#include "terrain/world_factory.h"
+#include "nodes/camera/ground_scene.h"
 
 namespace {
 
@@ -41,17 +40,10 @@ int main(int argc, char** argv) {
     if (params.cameras.empty()) params.cameras["down"] = nadir::camera::CameraSpec{};
     std::cout << "nadir-camera parameters:\n" << nadir::core::formatParamsOf(params) << std::flush;
 
-    const nadir::terrain::BuiltWorld built = nadir::terrain::makeWorld(params.world);
-    std::cout << "world: " << built.description << "\n";
-    nadir::render::HeadlessGlContext context;
-    std::cout << "rendering with " << context.info().gl_renderer << "\n";
-    auto tiles = std::make_shared<nadir::terrain::TileTree>(built.world, params.tiles);
-    nadir::render::TerrainRenderer terrain(tiles, params.renderer);
-    std::vector<nadir::terrain::GroundTarget> targets;
-    for (const auto& [name, target] : params.targets) targets.push_back(target);
-    nadir::terrain::resolveGeodeticTargets(targets, nadir::core::LocalNedFrame(built.origin));
-    terrain.setTargets(targets);
-    nadir::camera::CameraRig rig(terrain, params.cameras);
+    nadir::camera::GroundScene scene(params.world, params.tiles, params.renderer, params.targets);
+    std::cout << "world: " << scene.built.description << "\n"
+              << "rendering with " << scene.context.info().gl_renderer << "\n";
+    nadir::camera::CameraRig rig(scene.terrain, params.cameras);
 
     auto bus = nadir::core::openBus(params.bus);
     std::cout << "bus: " << bus->url() << ", poses from " << params.pose_channel << std::endl;
