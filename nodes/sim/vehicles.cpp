@@ -1,0 +1,249 @@
+#include "nodes/sim/vehicles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "core/frames.h"
+
+namespace nadir::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+double wrapAngle(double angle_rad) { return std::remainder(angle_rad, 2.0 * std::numbers::pi); }
+
+Eigen::Vector2d horizontal(const Eigen::Vector3d& p) { return {p.x(), p.y()}; }
+
+// Body rates from Euler angle rates (Z-Y-X), body frame.
+Eigen::Vector3d bodyRates(const core::RollPitchYaw& rpy, double roll_dot, double pitch_dot,
+                          double yaw_dot) {
+  const double sr = std::sin(rpy.roll_rad), cr = std::cos(rpy.roll_rad);
+  const double sp = std::sin(rpy.pitch_rad), cp = std::cos(rpy.pitch_rad);
+  return {roll_dot - yaw_dot * sp, pitch_dot * cr + yaw_dot * sr * cp,
+          -pitch_dot * sr + yaw_dot * cr * cp};
+}
+
+std::int64_t stepMicroseconds(double step_s) { return std::llround(step_s * 1e6); }
+
+// Gaussian from two uniforms (Box-Muller): the same on every standard library.
+double gaussian(std::mt19937_64& random) {
+  const double u1 = (static_cast<double>(random() >> 11) + 0.5) * 0x1.0p-53;
+  const double u2 = (static_cast<double>(random() >> 11) + 0.5) * 0x1.0p-53;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+}
+
+}  // namespace
+
+void FixedWingParams::visit(core::ParamVisitor& v) {
+  v.field("airspeed_mps", &airspeed_mps, {.doc = "true airspeed, m/s", .min = 1, .max = 300});
+  v.field("max_roll_rate_dps", &max_roll_rate_dps,
+          {.doc = "largest roll rate, deg/s", .min = 1, .max = 720});
+  v.field("max_bank_deg", &max_bank_deg, {.doc = "largest bank angle, deg", .min = 1, .max = 80});
+  v.field("max_climb_rate_mps", &max_climb_rate_mps,
+          {.doc = "largest climb or descent rate, m/s", .min = 0.1, .max = 50});
+  v.field("lookahead_m", &lookahead_m,
+          {.doc = "lateral guidance: aim this far ahead along the leg, m", .min = 1, .max = 10000});
+  v.field("wind_ned_mps", &wind_ned_mps,
+          {.doc = "constant wind (air moving towards) north, east, down, m/s",
+           .min = -100,
+           .max = 100,
+           .list_size = 3});
+  v.field("turbulence_mps", &turbulence_mps,
+          {.doc = "standard deviation of the gusts per axis, m/s; 0 = calm", .min = 0, .max = 30});
+  v.field("turbulence_time_constant_s", &turbulence_time_constant_s,
+          {.doc = "correlation time of the gusts, s", .min = 0.01, .max = 600});
+  v.field("seed", &seed, {.doc = "seed of the turbulence"});
+  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
+}
+
+FixedWing::FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start_ned,
+                     double heading_rad, std::vector<Eigen::Vector3d> waypoints_ned)
+    : params_(params),
+      waypoints_(std::move(waypoints_ned)),
+      leg_start_ned_(start_ned),
+      heading_rad_(heading_rad),
+      random_(static_cast<std::uint64_t>(params.seed)) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  if (waypoints_.empty()) throw std::invalid_argument("the fixed-wing has no waypoint to fly to");
+  // Two waypoints closer than a full turn cannot both be flown through.
+  const double min_leg_m = 2.0 * minimumTurnRadius_m();
+  Eigen::Vector3d previous = start_ned;
+  for (std::size_t i = 0; i < waypoints_.size(); ++i) {
+    const double leg_m = (horizontal(waypoints_[i]) - horizontal(previous)).norm();
+    if (leg_m < min_leg_m) {
+      throw std::invalid_argument(
+          "waypoint " + std::to_string(i + 1) + " is " + std::to_string(leg_m) +
+          " m from the one before: the aircraft needs at least " + std::to_string(min_leg_m) +
+          " m (two turn radii at " + std::to_string(params_.airspeed_mps) + " m/s and " +
+          std::to_string(params_.max_bank_deg) + " deg bank)");
+    }
+    previous = waypoints_[i];
+  }
+  state_.p_ned_m = start_ned;
+  state_.v_ned_mps =
+      params_.airspeed_mps * Eigen::Vector3d(std::cos(heading_rad), std::sin(heading_rad), 0.0) +
+      Eigen::Vector3d(params_.wind_ned_mps[0], params_.wind_ned_mps[1], params_.wind_ned_mps[2]);
+  state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
+}
+
+double FixedWing::minimumTurnRadius_m() const {
+  return params_.airspeed_mps * params_.airspeed_mps /
+         (kGravity_mps2 * std::tan(params_.max_bank_deg * kDeg));
+}
+
+void FixedWing::step() {
+  const double dt = params_.step_s;
+  const double airspeed = params_.airspeed_mps;
+  const double max_bank = params_.max_bank_deg * kDeg;
+  const Eigen::Vector3d p = state_.p_ned_m;
+
+  // Waypoint switching, with turn anticipation: start the turn where an arc at
+  // the maximum bank joins the next leg.
+  double bank_command = 0.0;
+  double altitude_target_m = -p.z();
+  if (!finished()) {
+    const Eigen::Vector3d& target = waypoints_[next_waypoint_];
+    const Eigen::Vector2d leg = horizontal(target) - horizontal(leg_start_ned_);
+    const Eigen::Vector2d leg_unit = leg.normalized();
+    const double along_m = (horizontal(p) - horizontal(leg_start_ned_)).dot(leg_unit);
+    double lead_m = 0.0;
+    if (next_waypoint_ + 1 < waypoints_.size()) {
+      const Eigen::Vector2d next_leg =
+          horizontal(waypoints_[next_waypoint_ + 1]) - horizontal(target);
+      const double turn_rad = std::abs(
+          wrapAngle(std::atan2(next_leg.y(), next_leg.x()) - std::atan2(leg.y(), leg.x())));
+      lead_m = std::min(minimumTurnRadius_m() * std::tan(0.5 * std::min(turn_rad, 2.8)),
+                        0.5 * leg.norm());
+    }
+    if (along_m >= leg.norm() - lead_m) {
+      leg_start_ned_ = target;
+      ++next_waypoint_;
+    }
+  }
+  if (!finished()) {
+    const Eigen::Vector3d& target = waypoints_[next_waypoint_];
+    altitude_target_m = -target.z();
+    const Eigen::Vector2d leg_unit = (horizontal(target) - horizontal(leg_start_ned_)).normalized();
+    const Eigen::Vector2d from_start = horizontal(p) - horizontal(leg_start_ned_);
+    const Eigen::Vector2d carrot =
+        horizontal(leg_start_ned_) + (from_start.dot(leg_unit) + params_.lookahead_m) * leg_unit;
+    const Eigen::Vector2d to_carrot = carrot - horizontal(p);
+    const double course_rad = std::atan2(state_.v_ned_mps.y(), state_.v_ned_mps.x());
+    const double error_rad = wrapAngle(std::atan2(to_carrot.y(), to_carrot.x()) - course_rad);
+    // Turn rate that closes the course error over the lookahead distance; past
+    // 90 deg off course, the full rate towards it.
+    const double limited_error = std::clamp(error_rad, -std::numbers::pi / 2, std::numbers::pi / 2);
+    const double turn_rate_rps = 2.0 * airspeed * std::sin(limited_error) / params_.lookahead_m;
+    bank_command =
+        std::clamp(std::atan(airspeed * turn_rate_rps / kGravity_mps2), -max_bank, max_bank);
+  }
+  const double max_roll_step = params_.max_roll_rate_dps * kDeg * dt;
+  const double previous_bank = bank_rad_;
+  bank_rad_ += std::clamp(bank_command - bank_rad_, -max_roll_step, max_roll_step);
+
+  const double yaw_rate_rps = kGravity_mps2 * std::tan(bank_rad_) / airspeed;
+  heading_rad_ = wrapAngle(heading_rad_ + yaw_rate_rps * dt);
+
+  const double climb_command = std::clamp(0.5 * (altitude_target_m - (-p.z())),
+                                          -params_.max_climb_rate_mps, params_.max_climb_rate_mps);
+  constexpr double kMaxClimbAcceleration_mps2 = 2.0;
+  const double previous_gamma = std::asin(climb_rate_mps_ / airspeed);
+  climb_rate_mps_ += std::clamp(climb_command - climb_rate_mps_, -kMaxClimbAcceleration_mps2 * dt,
+                                kMaxClimbAcceleration_mps2 * dt);
+  const double gamma = std::asin(std::clamp(climb_rate_mps_ / airspeed, -1.0, 1.0));
+
+  if (params_.turbulence_mps > 0.0) {
+    const double tau = params_.turbulence_time_constant_s;
+    for (int i = 0; i < 3; ++i) {
+      gust_ned_mps_[i] += -gust_ned_mps_[i] / tau * dt +
+                          params_.turbulence_mps * std::sqrt(2.0 * dt / tau) * gaussian(random_);
+    }
+  }
+  const Eigen::Vector3d air_velocity =
+      airspeed * Eigen::Vector3d(std::cos(heading_rad_) * std::cos(gamma),
+                                 std::sin(heading_rad_) * std::cos(gamma), -std::sin(gamma));
+  const Eigen::Vector3d wind(params_.wind_ned_mps[0], params_.wind_ned_mps[1],
+                             params_.wind_ned_mps[2]);
+  const Eigen::Vector3d velocity = air_velocity + wind + gust_ned_mps_;
+  state_.a_ned_mps2 = (velocity - state_.v_ned_mps) / dt;
+  state_.v_ned_mps = velocity;
+  state_.p_ned_m = p + velocity * dt;
+  const core::RollPitchYaw rpy{bank_rad_, gamma, heading_rad_};
+  state_.q_world_body = core::quaternionFromRpy(rpy);
+  state_.omega_body_rps =
+      bodyRates(rpy, (bank_rad_ - previous_bank) / dt, (gamma - previous_gamma) / dt, yaw_rate_rps);
+  state_.utime += stepMicroseconds(dt);
+}
+
+void MultirotorParams::visit(core::ParamVisitor& v) {
+  v.field("speed_mps", &speed_mps, {.doc = "cruise speed along a leg, m/s", .min = 0.1, .max = 50});
+  v.field("acceleration_mps2", &acceleration_mps2,
+          {.doc = "acceleration and braking, m/s^2", .min = 0.1, .max = 20});
+  v.field("yaw_rate_dps", &yaw_rate_dps,
+          {.doc = "yaw rate when turning, deg/s", .min = 1, .max = 720});
+  v.field("yaw_at_corners", &yaw_at_corners,
+          {.doc = "stop and turn to face each new leg (else keep the start heading)"});
+  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
+}
+
+Multirotor::Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned,
+                       double heading_rad, std::vector<Eigen::Vector3d> waypoints_ned)
+    : params_(params), waypoints_(std::move(waypoints_ned)), yaw_rad_(heading_rad) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  if (waypoints_.empty()) throw std::invalid_argument("the multirotor has no waypoint to fly to");
+  state_.p_ned_m = start_ned;
+  state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
+}
+
+void Multirotor::step() {
+  const double dt = params_.step_s;
+  const Eigen::Vector3d previous_velocity = state_.v_ned_mps;
+  const core::RollPitchYaw previous_rpy = core::rpyFromQuaternion(state_.q_world_body);
+  double yaw_rate_rps = 0.0;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  if (!finished()) {
+    const Eigen::Vector3d to_target = waypoints_[next_waypoint_] - state_.p_ned_m;
+    const double distance_m = to_target.norm();
+    const double leg_course = std::atan2(to_target.y(), to_target.x());
+    const double yaw_error = wrapAngle(leg_course - yaw_rad_);
+    const double max_yaw_step = params_.yaw_rate_dps * kDeg * dt;
+    const bool must_turn = params_.yaw_at_corners && speed_mps_ == 0.0 &&
+                           horizontal(to_target).norm() > 1e-6 && std::abs(yaw_error) > 1e-9;
+    if (must_turn) {
+      const double yaw_step = std::clamp(yaw_error, -max_yaw_step, max_yaw_step);
+      yaw_rad_ = wrapAngle(yaw_rad_ + yaw_step);
+      yaw_rate_rps = yaw_step / dt;
+    } else {
+      // Accelerate to cruise, brake so as to stop on the waypoint.
+      speed_mps_ = std::min({speed_mps_ + params_.acceleration_mps2 * dt, params_.speed_mps,
+                             std::sqrt(2.0 * params_.acceleration_mps2 * distance_m)});
+      if (distance_m <= speed_mps_ * dt || distance_m < 1e-9) {
+        velocity = to_target / dt;
+        speed_mps_ = 0.0;
+        ++next_waypoint_;
+      } else {
+        velocity = to_target / distance_m * speed_mps_;
+      }
+    }
+  }
+  state_.p_ned_m += velocity * dt;
+  // On arrival the position snaps onto the waypoint and the vehicle is at rest.
+  state_.v_ned_mps = speed_mps_ == 0.0 ? Eigen::Vector3d::Zero() : velocity;
+  state_.a_ned_mps2 = (state_.v_ned_mps - previous_velocity) / dt;
+  // Tilt: the thrust must supply the horizontal acceleration, seen in the heading frame.
+  const Eigen::Vector3d& a = state_.a_ned_mps2;
+  const double forward = std::cos(yaw_rad_) * a.x() + std::sin(yaw_rad_) * a.y();
+  const double right = -std::sin(yaw_rad_) * a.x() + std::cos(yaw_rad_) * a.y();
+  const double pitch = -std::atan2(forward, kGravity_mps2 - a.z());
+  const double roll = std::atan2(right * std::cos(pitch), kGravity_mps2 - a.z());
+  const core::RollPitchYaw rpy{roll, pitch, yaw_rad_};
+  state_.q_world_body = core::quaternionFromRpy(rpy);
+  state_.omega_body_rps = bodyRates(rpy, (roll - previous_rpy.roll_rad) / dt,
+                                    (pitch - previous_rpy.pitch_rad) / dt, yaw_rate_rps);
+  state_.utime += stepMicroseconds(dt);
+}
+
+}  // namespace nadir::sim

@@ -1,0 +1,102 @@
+#pragma once
+// Vehicle models for the simulator: kinematic, deterministic, stepped at a
+// fixed rate in sim time. Each follows a list of waypoints in the world frame
+// (local NED) and exposes its true state. No LCM here.
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/params.h"
+#include "nodes/sim/vehicle_state.h"
+
+namespace nadir::sim {
+
+// Fixed-wing aircraft in coordinated flight: constant airspeed, turn rate
+// g tan(bank) / airspeed, bank limited in angle and rate, climb rate limited,
+// waypoints followed along their legs with turn anticipation, optional
+// constant wind and seeded turbulence.
+struct FixedWingParams {
+  double airspeed_mps = 20.0;
+  double max_roll_rate_dps = 45.0;
+  double max_bank_deg = 45.0;
+  double max_climb_rate_mps = 3.0;
+  // Lateral guidance: aim at a point this far ahead along the current leg.
+  double lookahead_m = 80.0;
+  std::vector<double> wind_ned_mps = {0.0, 0.0, 0.0};
+  // Turbulence: a first-order (Dryden-like) gust per axis, standard deviation.
+  double turbulence_mps = 0.0;
+  double turbulence_time_constant_s = 2.0;
+  std::int64_t seed = 1;
+  double step_s = 0.0025;
+
+  void visit(core::ParamVisitor& v);
+};
+
+class FixedWing {
+ public:
+  // Starts at start_ned, flying level along heading_rad, towards the waypoints.
+  // Throws std::invalid_argument for an empty waypoint list or a waypoint the
+  // aircraft cannot reach (closer to the previous one than twice the minimum turn radius).
+  FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+            std::vector<Eigen::Vector3d> waypoints_ned);
+
+  // Advances one step of params.step_s.
+  void step();
+  const VehicleState& state() const { return state_; }
+  // True once the last waypoint has been passed.
+  bool finished() const { return next_waypoint_ >= waypoints_.size(); }
+  double bank_rad() const { return bank_rad_; }
+  double heading_rad() const { return heading_rad_; }
+  std::size_t nextWaypoint() const { return next_waypoint_; }
+  // Radius of a turn at the maximum bank, m.
+  double minimumTurnRadius_m() const;
+
+ private:
+  FixedWingParams params_;
+  std::vector<Eigen::Vector3d> waypoints_;
+  std::size_t next_waypoint_ = 0;
+  Eigen::Vector3d leg_start_ned_;
+  VehicleState state_;
+  double heading_rad_ = 0.0;
+  double bank_rad_ = 0.0;
+  double climb_rate_mps_ = 0.0;
+  Eigen::Vector3d gust_ned_mps_ = Eigen::Vector3d::Zero();
+  std::mt19937_64 random_;
+};
+
+// Multirotor: flies each leg at a set speed with limited acceleration,
+// stopping at waypoints; with yaw_at_corners it turns on the spot to face each
+// new leg (the 90 deg yaw at the rectangle's corners of seed 000). Tilt follows
+// the acceleration.
+struct MultirotorParams {
+  double speed_mps = 3.0;
+  double acceleration_mps2 = 1.5;
+  double yaw_rate_dps = 45.0;
+  bool yaw_at_corners = true;
+  double step_s = 0.0025;
+
+  void visit(core::ParamVisitor& v);
+};
+
+class Multirotor {
+ public:
+  Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+             std::vector<Eigen::Vector3d> waypoints_ned);
+  void step();
+  const VehicleState& state() const { return state_; }
+  bool finished() const { return next_waypoint_ >= waypoints_.size(); }
+  double yaw_rad() const { return yaw_rad_; }
+
+ private:
+  MultirotorParams params_;
+  std::vector<Eigen::Vector3d> waypoints_;
+  std::size_t next_waypoint_ = 0;
+  VehicleState state_;
+  double yaw_rad_ = 0.0;
+  double speed_mps_ = 0.0;
+};
+
+}  // namespace nadir::sim

@@ -1,0 +1,155 @@
+// Vehicle models against their limits and against turn geometry worked out by hand.
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "core/frames.h"
+#include "nodes/sim/vehicles.h"
+
+namespace nadir::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Radius of the circle through three points.
+double circumradius(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const double ab = (a - b).norm(), bc = (b - c).norm(), ca = (c - a).norm();
+  const double cross = std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+  return ab * bc * ca / (2.0 * cross);
+}
+
+// Over a zig-zag, the bank never exceeds its limit nor changes faster than the roll-rate limit.
+TEST(FixedWing, NeverExceedsBankAndRollRateLimits) {
+  FixedWingParams params;
+  params.airspeed_mps = 25.0;
+  params.max_bank_deg = 30.0;
+  params.max_roll_rate_dps = 25.0;
+  std::vector<Eigen::Vector3d> zigzag;
+  for (int i = 1; i <= 8; ++i) zigzag.emplace_back(400.0 * i, (i % 2 ? 300.0 : -300.0), -100.0);
+  FixedWing aircraft(params, {0, 0, -100}, 0.0, zigzag);
+  double previous = aircraft.bank_rad(), largest = 0.0;
+  const double max_step = 25.0 * kDeg * params.step_s;
+  for (int i = 0; i < 400 * 200 && !aircraft.finished(); ++i) {
+    aircraft.step();
+    ASSERT_LE(std::abs(aircraft.bank_rad()), 30.0 * kDeg + 1e-12);
+    ASSERT_LE(std::abs(aircraft.bank_rad() - previous), max_step + 1e-12);
+    largest = std::max(largest, std::abs(aircraft.bank_rad()));
+    previous = aircraft.bank_rad();
+  }
+  EXPECT_TRUE(aircraft.finished());
+  EXPECT_NEAR(largest, 30.0 * kDeg, 1e-9) << "the zig-zag should need full bank";
+}
+
+// A steady turn at full bank has radius v^2 / (g tan(bank)): 20 m/s at 45 deg -> 40.79 m.
+TEST(FixedWing, SteadyTurnRadiusMatchesCoordinatedTurn) {
+  FixedWingParams params;
+  params.airspeed_mps = 20.0;
+  params.max_bank_deg = 45.0;
+  params.max_roll_rate_dps = 90.0;
+  // A waypoint behind: the aircraft turns round at full bank.
+  FixedWing aircraft(params, {0, 0, -100}, 0.0, {Eigen::Vector3d(-2000.0, 1.0, -100.0)});
+  while (std::abs(aircraft.bank_rad()) < 45.0 * kDeg - 1e-12) aircraft.step();
+  std::vector<Eigen::Vector2d> points;
+  const double start_heading = aircraft.heading_rad();
+  for (int i = 0; i < 3; ++i) {
+    while (std::abs(std::remainder(aircraft.heading_rad() - start_heading, 2 * std::numbers::pi)) <
+           i * 30.0 * kDeg) {
+      aircraft.step();
+      ASSERT_NEAR(std::abs(aircraft.bank_rad()), 45.0 * kDeg, 1e-12) << "left full bank too early";
+    }
+    points.emplace_back(aircraft.state().p_ned_m.x(), aircraft.state().p_ned_m.y());
+  }
+  const double expected_m = 20.0 * 20.0 / (9.80665 * std::tan(45.0 * kDeg));
+  EXPECT_NEAR(circumradius(points[0], points[1], points[2]), expected_m, 0.01 * expected_m);
+}
+
+// Wind turns air velocity into a different ground velocity: level, straight, with a 5 m/s
+// crosswind.
+TEST(FixedWing, WindAddsToGroundVelocity) {
+  FixedWingParams params;
+  params.wind_ned_mps = {0.0, 5.0, 0.0};
+  FixedWing aircraft(params, {0, 0, -100}, 0.0, {Eigen::Vector3d(5000.0, 0.0, -100.0)});
+  for (int i = 0; i < 24000; ++i) aircraft.step();  // 60 s: settled on the leg
+  EXPECT_NEAR(aircraft.state().p_ned_m.y(), 0.0, 0.5);
+  // Holding the leg, the aircraft crabs: ground track north, airspeed 20 m/s into the wind.
+  EXPECT_NEAR(aircraft.state().v_ned_mps.y(), 0.0, 0.05);
+  EXPECT_NEAR(aircraft.state().v_ned_mps.x(), std::sqrt(20.0 * 20.0 - 25.0), 0.05);
+}
+
+// Two runs with one seed are identical, also with turbulence; another seed differs.
+TEST(FixedWing, SameSeedSameFlight) {
+  FixedWingParams params;
+  params.turbulence_mps = 1.5;
+  params.seed = 7;
+  const std::vector<Eigen::Vector3d> waypoints = {{600, 200, -120}, {0, 600, -80}};
+  FixedWing a(params, {0, 0, -100}, 0.0, waypoints), b(params, {0, 0, -100}, 0.0, waypoints);
+  params.seed = 8;
+  FixedWing c(params, {0, 0, -100}, 0.0, waypoints);
+  for (int i = 0; i < 8000; ++i) {
+    a.step();
+    b.step();
+    c.step();
+  }
+  EXPECT_EQ(a.state().p_ned_m, b.state().p_ned_m);
+  EXPECT_EQ(a.state().q_world_body.coeffs(), b.state().q_world_body.coeffs());
+  EXPECT_NE(a.state().p_ned_m, c.state().p_ned_m);
+}
+
+// Waypoints closer than two turn radii are refused, naming the waypoint; bad speeds too.
+TEST(FixedWing, UnreachableWaypointsAndBadParamsAreRefused) {
+  FixedWingParams params;  // 20 m/s, 45 deg: turn radius 40.8 m
+  try {
+    FixedWing(params, {0, 0, -100}, 0.0,
+              {Eigen::Vector3d(500, 0, -100), Eigen::Vector3d(530, 0, -100)});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("waypoint 2"), std::string::npos) << error.what();
+  }
+  params.airspeed_mps = -3.0;
+  EXPECT_THROW(FixedWing(params, {0, 0, 0}, 0.0, {Eigen::Vector3d(500, 0, 0)}), core::ParamError);
+}
+
+// Seed 000's rectangle: 50 m x 25 m flown four times is 600 m, and the multirotor
+// faces along each leg, yawing 90 deg at every corner.
+TEST(Multirotor, RectangleWithNinetyDegreeYaws) {
+  MultirotorParams params;
+  const std::vector<Eigen::Vector3d> corners = {{50, 0, -5}, {50, 25, -5}, {0, 25, -5}, {0, 0, -5}};
+  std::vector<Eigen::Vector3d> laps;
+  for (int lap = 0; lap < 4; ++lap) laps.insert(laps.end(), corners.begin(), corners.end());
+  Multirotor drone(params, {0, 0, -5}, 0.0, laps);
+  double length_m = 0.0;
+  Eigen::Vector3d previous = drone.state().p_ned_m;
+  std::vector<double> yaw_while_moving;
+  while (!drone.finished()) {
+    drone.step();
+    length_m += (drone.state().p_ned_m - previous).norm();
+    if (drone.state().v_ned_mps.norm() > 1.0) {
+      const Eigen::Vector3d v = drone.state().v_ned_mps;
+      EXPECT_NEAR(std::remainder(drone.yaw_rad() - std::atan2(v.y(), v.x()), 2 * std::numbers::pi),
+                  0.0, 1e-9);
+    }
+    previous = drone.state().p_ned_m;
+    ASSERT_LT(drone.state().utime, 1'000'000'000) << "never finished";
+  }
+  EXPECT_NEAR(length_m, 600.0, 0.02 * 600.0);
+  // Back at the start after the last leg west: yaw -90 deg.
+  EXPECT_NEAR(std::remainder(drone.yaw_rad() + std::numbers::pi / 2, 2 * std::numbers::pi), 0.0,
+              1e-9);
+}
+
+// The multirotor tilts into its acceleration: nose down to speed up forward.
+TEST(Multirotor, TiltsWithAcceleration) {
+  MultirotorParams params;
+  params.acceleration_mps2 = 2.0;
+  Multirotor drone(params, {0, 0, -10}, 0.0, {Eigen::Vector3d(100, 0, -10)});
+  for (int i = 0; i < 100; ++i) drone.step();
+  const core::RollPitchYaw rpy = core::rpyFromQuaternion(drone.state().q_world_body);
+  // 2 m/s^2 forward: pitch = -atan(2 / g) = -11.53 deg.
+  EXPECT_NEAR(rpy.pitch_rad, -std::atan(2.0 / 9.80665), 1e-9);
+  EXPECT_NEAR(rpy.roll_rad, 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace nadir::sim
