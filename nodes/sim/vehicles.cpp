@@ -246,4 +246,62 @@ void Multirotor::step() {
   state_.utime += stepMicroseconds(dt);
 }
 
+void RoverParams::visit(core::ParamVisitor& v) {
+  v.field("speed_mps", &speed_mps, {.doc = "driving speed, m/s", .min = 0.01, .max = 50});
+  v.field("wheelbase_m", &wheelbase_m, {.doc = "front to rear axle, m", .min = 0.01, .max = 10});
+  v.field("max_steer_deg", &max_steer_deg,
+          {.doc = "largest steering angle, deg", .min = 1, .max = 60});
+  v.field("max_steer_rate_dps", &max_steer_rate_dps,
+          {.doc = "largest steering rate, deg/s", .min = 1, .max = 1000});
+  v.field("lookahead_m", &lookahead_m,
+          {.doc = "pure pursuit lookahead, m", .min = 0.01, .max = 100});
+  v.field("arrival_radius_m", &arrival_radius_m,
+          {.doc = "a waypoint is reached within this distance, m", .min = 0.001, .max = 100});
+  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
+}
+
+Rover::Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+             std::vector<Eigen::Vector3d> waypoints_ned)
+    : params_(params), waypoints_(std::move(waypoints_ned)), heading_rad_(heading_rad) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  if (waypoints_.empty()) throw std::invalid_argument("the rover has no waypoint to drive to");
+  state_.p_ned_m = start_ned;
+  state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
+}
+
+void Rover::step() {
+  const double dt = params_.step_s;
+  const Eigen::Vector3d previous_velocity = state_.v_ned_mps;
+  double speed = 0.0;
+  double steer_command = 0.0;
+  if (!finished() && (horizontal(waypoints_[next_waypoint_]) - horizontal(state_.p_ned_m)).norm() <=
+                         params_.arrival_radius_m) {
+    ++next_waypoint_;
+  }
+  if (!finished()) {
+    speed = params_.speed_mps;
+    // Pure pursuit: the arc through the goal point ahead, curvature 2 sin(alpha) / L.
+    const Eigen::Vector2d to_goal =
+        horizontal(waypoints_[next_waypoint_]) - horizontal(state_.p_ned_m);
+    const double alpha = wrapAngle(std::atan2(to_goal.y(), to_goal.x()) - heading_rad_);
+    const double distance = std::max(std::min(to_goal.norm(), params_.lookahead_m), 1e-6);
+    // A goal behind gets the tightest turn towards it, not none.
+    const double curvature =
+        2.0 * std::sin(std::clamp(alpha, -std::numbers::pi / 2, std::numbers::pi / 2)) / distance;
+    steer_command = std::atan(params_.wheelbase_m * curvature);
+  }
+  const double max_steer = params_.max_steer_deg * kDeg;
+  const double max_steer_step = params_.max_steer_rate_dps * kDeg * dt;
+  steer_rad_ += std::clamp(std::clamp(steer_command, -max_steer, max_steer) - steer_rad_,
+                           -max_steer_step, max_steer_step);
+  const double yaw_rate_rps = speed * std::tan(steer_rad_) / params_.wheelbase_m;
+  heading_rad_ = wrapAngle(heading_rad_ + yaw_rate_rps * dt);
+  state_.v_ned_mps = speed * Eigen::Vector3d(std::cos(heading_rad_), std::sin(heading_rad_), 0.0);
+  state_.p_ned_m += state_.v_ned_mps * dt;
+  state_.a_ned_mps2 = (state_.v_ned_mps - previous_velocity) / dt;
+  state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad_});
+  state_.omega_body_rps = Eigen::Vector3d(0.0, 0.0, yaw_rate_rps);
+  state_.utime += stepMicroseconds(dt);
+}
+
 }  // namespace nadir::sim

@@ -99,4 +99,39 @@ class Multirotor {
   double speed_mps_ = 0.0;
 };
 
+// Ground rover: kinematic bicycle model (rear-axle reference point) on flat
+// ground at a constant speed, steering limited in angle and rate, following
+// waypoints by pure pursuit (for seed 001's gate and slalom tasks).
+struct RoverParams {
+  double speed_mps = 1.0;
+  double wheelbase_m = 0.3;
+  double max_steer_deg = 30.0;
+  double max_steer_rate_dps = 90.0;
+  double lookahead_m = 1.0;
+  // A waypoint counts as reached within this distance.
+  double arrival_radius_m = 0.2;
+  double step_s = 0.0025;
+
+  void visit(core::ParamVisitor& v);
+};
+
+class Rover {
+ public:
+  Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+        std::vector<Eigen::Vector3d> waypoints_ned);
+  void step();
+  const VehicleState& state() const { return state_; }
+  bool finished() const { return next_waypoint_ >= waypoints_.size(); }
+  double steer_rad() const { return steer_rad_; }
+  double heading_rad() const { return heading_rad_; }
+
+ private:
+  RoverParams params_;
+  std::vector<Eigen::Vector3d> waypoints_;
+  std::size_t next_waypoint_ = 0;
+  VehicleState state_;
+  double heading_rad_ = 0.0;
+  double steer_rad_ = 0.0;
+};
+
 }  // namespace nadir::sim

@@ -151,5 +151,43 @@ TEST(Multirotor, TiltsWithAcceleration) {
   EXPECT_NEAR(rpy.roll_rad, 0.0, 1e-9);
 }
 
+// The rover's turn at full steering has radius wheelbase / tan(steer): 0.3 m at
+// 30 deg -> 0.520 m; it never steers past its limits; it reaches a slalom's gates.
+TEST(Rover, BicycleTurnRadiusAndSteeringLimits) {
+  RoverParams params;
+  Rover rover(params, {0, 0, 0}, 0.0, {Eigen::Vector3d(-20.0, 0.1, 0.0)});
+  const double max_step = params.max_steer_rate_dps * kDeg * params.step_s;
+  double previous = rover.steer_rad();
+  while (std::abs(rover.steer_rad()) < 30.0 * kDeg - 1e-12) {
+    rover.step();
+    ASSERT_LE(std::abs(rover.steer_rad() - previous), max_step + 1e-12);
+    previous = rover.steer_rad();
+  }
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 100; ++j) {
+      rover.step();
+      ASSERT_NEAR(std::abs(rover.steer_rad()), 30.0 * kDeg, 1e-12);
+    }
+    points.emplace_back(rover.state().p_ned_m.x(), rover.state().p_ned_m.y());
+  }
+  const double expected_m = 0.3 / std::tan(30.0 * kDeg);
+  EXPECT_NEAR(circumradius(points[0], points[1], points[2]), expected_m, 0.01 * expected_m);
+}
+
+// Through a slalom of gates 3 m apart, the rover passes within its arrival radius of each.
+TEST(Rover, DrivesASlalom) {
+  RoverParams params;
+  std::vector<Eigen::Vector3d> gates;
+  for (int i = 1; i <= 6; ++i) gates.emplace_back(3.0 * i, (i % 2 ? 0.6 : -0.6), 0.0);
+  Rover rover(params, {0, 0, 0}, 0.0, gates);
+  for (int i = 0; i < 400 * 60 && !rover.finished(); ++i) {
+    rover.step();
+    ASSERT_LE(std::abs(rover.steer_rad()), 30.0 * kDeg + 1e-12);
+  }
+  EXPECT_TRUE(rover.finished());
+  EXPECT_NEAR(rover.state().p_ned_m.x(), 18.0, params.arrival_radius_m);
+}
+
 }  // namespace
 }  // namespace nadir::sim
