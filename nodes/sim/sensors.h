@@ -1,0 +1,246 @@
+#pragma once
+// Sensor models of the simulator: IMU, rangefinder, GPS and barometer. Plain
+// structs in, plain structs out, no LCM (the sim node wires them to messages).
+//
+// Every model is deterministic: it owns a std::mt19937_64 seeded from its
+// params (a fixed default seed) and draws Gaussian noise with its own
+// Box-Muller transform (std::normal_distribution is implementation-defined),
+// so the same seed and the same sequence of sample() calls give the same
+// outputs on every standard library. Each sample() draws the same number of
+// random numbers whatever the state (also without a fix or out of range), so
+// the noise of one sample never depends on the status of an earlier one.
+//
+// sample() computes a measurement whenever it is called; the caller decides
+// when with due(), at the model's rate_hz.
+
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/geodesy.h"
+#include "core/params.h"
+#include "nodes/sim/vehicle_state.h"
+#include "terrain/world.h"
+
+namespace nadir::sim {
+
+// Initial value of a next_due_utime for due(): the first call is due.
+inline constexpr std::int64_t kDueAtFirstCall = std::numeric_limits<std::int64_t>::min();
+
+// Fixed-grid sampling in message time. The first call (next_due_utime ==
+// kDueAtFirstCall) is due and anchors the grid at utime; after that a call is
+// due when utime has reached next_due_utime, and due times advance on the grid
+// anchor + k * period, period = 1e6 / rate_hz rounded to whole microseconds
+// (at least 1). If utime skips grid points, one sample is due and the next due
+// time is the first grid point after utime: the grid never drifts. Throws
+// std::invalid_argument if rate_hz is not positive and finite.
+bool due(std::int64_t utime, double rate_hz, std::int64_t& next_due_utime);
+
+// Gaussian noise source: std::mt19937_64 and Box-Muller, identical on every
+// platform's standard library (up to the last bit of std::log/std::cos).
+class GaussianNoise {
+ public:
+  explicit GaussianNoise(std::uint64_t seed) : engine_(seed) {}
+  // A standard normal variate.
+  double standardNormal();
+  double normal(double sigma) { return sigma * standardNormal(); }
+
+ private:
+  std::mt19937_64 engine_;
+  bool has_spare_ = false;
+  double spare_ = 0.0;
+};
+
+// ---------------------------------------------------------------- IMU
+
+struct ImuParams {
+  double rate_hz = 200.0;
+  std::int64_t seed = 1;
+  double gyro_noise_density_rps_rthz = 2.0e-4;
+  double accel_noise_density_mps2_rthz = 2.0e-3;
+  double gyro_bias_random_walk_rps_rts = 2.0e-5;
+  double accel_bias_random_walk_mps2_rts = 2.0e-4;
+  std::vector<double> gyro_initial_bias_rps = {0.0, 0.0, 0.0};
+  std::vector<double> accel_initial_bias_mps2 = {0.0, 0.0, 0.0};
+
+  void visit(core::ParamVisitor& v);
+};
+
+struct ImuSample {
+  std::int64_t utime = 0;
+  // Body FRD, rad/s.
+  Eigen::Vector3d angular_velocity_rps = Eigen::Vector3d::Zero();
+  // Specific force in body FRD, m/s^2: a level vehicle at rest reads (0, 0, -g).
+  Eigen::Vector3d linear_acceleration_mps2 = Eigen::Vector3d::Zero();
+};
+
+// Gyro and accelerometer: truth + bias + white noise. The white noise has the
+// per-sample sigma density * sqrt(rate_hz); the biases start at the initial
+// biases and take a random-walk step of sigma * sqrt(dt) at every call, dt
+// from the utime difference to the previous call (none at the first call).
+class ImuModel {
+ public:
+  // Throws core::ParamError if a parameter is out of its range.
+  explicit ImuModel(const ImuParams& params);
+
+  // Throws std::invalid_argument if state.utime is before the previous call's.
+  ImuSample sample(const VehicleState& state);
+
+  const Eigen::Vector3d& gyroBias_rps() const { return gyro_bias_rps_; }
+  const Eigen::Vector3d& accelBias_mps2() const { return accel_bias_mps2_; }
+
+ private:
+  ImuParams params_;
+  GaussianNoise noise_;
+  Eigen::Vector3d gyro_bias_rps_;
+  Eigen::Vector3d accel_bias_mps2_;
+  bool has_previous_ = false;
+  std::int64_t previous_utime_ = 0;
+};
+
+// True specific force in body FRD: R_world_body^T (a_ned - g_ned), g_ned = (0, 0, +g).
+Eigen::Vector3d trueSpecificForce_mps2(const VehicleState& state);
+
+// ---------------------------------------------------------------- rangefinder
+
+struct RangefinderParams {
+  double rate_hz = 50.0;
+  std::int64_t seed = 2;
+  double min_range_m = 0.1;
+  double max_range_m = 100.0;
+  double noise_sigma_m = 0.02;
+  std::vector<double> direction_body = {0.0, 0.0, 1.0};
+  double march_step_m = 0.5;
+
+  void visit(core::ParamVisitor& v);
+};
+
+enum class RangeStatus { VALID, TOO_CLOSE, OUT_OF_RANGE };
+
+struct RangeSample {
+  std::int64_t utime = 0;
+  // Measured distance from the body origin along direction_body, m. With
+  // TOO_CLOSE it is min_range_m, with OUT_OF_RANGE max_range_m (no noise).
+  double range_m = 0.0;
+  RangeStatus status = RangeStatus::OUT_OF_RANGE;
+  // Unit direction of the beam in body FRD.
+  Eigen::Vector3d direction_body = Eigen::Vector3d::UnitZ();
+};
+
+// A beam from the body origin along direction_body to the ground of a
+// terrain::World. The first crossing is found by marching along the ray in
+// march_step_m steps (a ridge thinner than a step can be missed) and then
+// bisection to 1 mm. A body origin at or under the ground reads TOO_CLOSE.
+class RangefinderModel {
+ public:
+  // Throws core::ParamError if a parameter is out of its range, min_range_m >=
+  // max_range_m or direction_body is (nearly) zero.
+  explicit RangefinderModel(const RangefinderParams& params);
+
+  RangeSample sample(const VehicleState& state, const terrain::World& world);
+
+ private:
+  RangefinderParams params_;
+  Eigen::Vector3d direction_body_;
+  GaussianNoise noise_;
+};
+
+// Noise-free distance from p_ned_m along the unit world direction to the
+// first ground crossing, within max_range_m (march and bisection to 1 mm).
+// Returns a negative value if there is none; 0 if p_ned_m is at or under the ground.
+double rayGroundDistance_m(const terrain::World& world, const Eigen::Vector3d& p_ned_m,
+                           const Eigen::Vector3d& direction_world, double max_range_m,
+                           double march_step_m);
+
+// ---------------------------------------------------------------- GPS
+
+struct GpsParams {
+  double rate_hz = 5.0;
+  std::int64_t seed = 3;
+  double horizontal_sigma_m = 1.5;
+  double vertical_sigma_m = 3.0;
+  double velocity_sigma_mps = 0.1;
+  int num_satellites = 12;
+  // Outage windows in sim time, s: flat [start_s, end_s, start_s, end_s, ...].
+  std::vector<double> outages_s = {};
+
+  // Throws core::ParamError (from the walk) if outages_s has an odd length or
+  // a window ends before it starts.
+  void visit(core::ParamVisitor& v);
+};
+
+enum class GpsFix { NONE, FIX_3D };
+
+struct GpsSample {
+  std::int64_t utime = 0;
+  // WGS-84; alt_m above the ellipsoid. Zero without a fix.
+  double lat_rad = 0.0;
+  double lon_rad = 0.0;
+  double alt_m = 0.0;
+  Eigen::Vector3d velocity_ned_mps = Eigen::Vector3d::Zero();
+  // 1-sigma error per horizontal axis and vertically, m. Zero without a fix.
+  double horizontal_accuracy_m = 0.0;
+  double vertical_accuracy_m = 0.0;
+  int num_satellites = 0;
+  GpsFix fix = GpsFix::NONE;
+};
+
+// Position (white noise in metres, north/east with horizontal_sigma_m, down
+// with vertical_sigma_m, converted exactly with the LocalNedFrame) and NED
+// velocity with white noise. Inside an outage window (start_s <= t < end_s,
+// t = utime / 1e6) the fix is NONE and the other fields are zero.
+class GpsModel {
+ public:
+  // Throws core::ParamError if a parameter is invalid.
+  explicit GpsModel(const GpsParams& params);
+
+  GpsSample sample(const VehicleState& state, const core::LocalNedFrame& frame);
+  bool inOutage(std::int64_t utime) const;
+
+ private:
+  GpsParams params_;
+  GaussianNoise noise_;
+};
+
+// ---------------------------------------------------------------- barometer
+
+struct BarometerParams {
+  double rate_hz = 50.0;
+  std::int64_t seed = 4;
+  double noise_sigma_m = 0.3;
+  double bias_random_walk_m_rts = 0.01;
+  double initial_bias_m = 0.0;
+
+  void visit(core::ParamVisitor& v);
+};
+
+struct BaroSample {
+  std::int64_t utime = 0;
+  // Altitude, m: the origin's height above the ellipsoid minus the down coordinate.
+  double altitude_m = 0.0;
+};
+
+// Altitude with white noise and a bias random walk (sigma * sqrt(dt) per call,
+// dt from the utime difference; none at the first call).
+class BarometerModel {
+ public:
+  // Throws core::ParamError if a parameter is out of its range.
+  explicit BarometerModel(const BarometerParams& params);
+
+  // Throws std::invalid_argument if state.utime is before the previous call's.
+  BaroSample sample(const VehicleState& state, const core::LocalNedFrame& frame);
+
+  double bias_m() const { return bias_m_; }
+
+ private:
+  BarometerParams params_;
+  GaussianNoise noise_;
+  double bias_m_;
+  bool has_previous_ = false;
+  std::int64_t previous_utime_ = 0;
+};
+
+}  // namespace nadir::sim
