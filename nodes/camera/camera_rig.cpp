@@ -43,13 +43,12 @@ CameraRig::CameraRig(render::TerrainRenderer& terrain,
     core::validateParams([&spec](core::ParamVisitor& v) { spec.visit(v); }, "cameras." + name);
     Camera camera;
     camera.renderer = std::make_unique<render::CameraRenderer>(terrain, spec.camera);
-    camera.period_us = std::llround(1e6 / spec.fps);
     cameras_.emplace(name, std::move(camera));
   }
 }
 
 void CameraRig::reset() {
-  for (auto& [name, camera] : cameras_) camera.next_due_utime = -1;
+  for (auto& [name, camera] : cameras_) camera.next_due_utime = core::kDueAtFirstCall;
   last_utime_ = -1;
 }
 
@@ -59,13 +58,11 @@ std::vector<CameraFrame> CameraRig::onPose(std::int64_t utime,
   last_utime_ = utime;
   std::vector<CameraFrame> frames;
   for (auto& [name, camera] : cameras_) {
-    if (camera.next_due_utime >= 0 && utime < camera.next_due_utime) continue;
     const CameraSpec& spec = specs_.at(name);
+    // Due times sit on a fixed grid, so a late pose does not shift later frames.
+    if (!core::due(utime, spec.fps, camera.next_due_utime)) continue;
     frames.push_back(
         {name, &spec, camera.renderer->render(T_world_body * spec.T_body_cam(), utime)});
-    // Due times sit on a fixed grid, so a late pose does not shift later frames.
-    if (camera.next_due_utime < 0) camera.next_due_utime = utime;
-    while (camera.next_due_utime <= utime) camera.next_due_utime += camera.period_us;
   }
   return frames;
 }

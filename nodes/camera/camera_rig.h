@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "core/clock.h"
 #include "core/params.h"
 #include "render/camera_renderer.h"
 #include "render/terrain_renderer.h"
@@ -59,8 +60,7 @@ class CameraRig {
  private:
   struct Camera {
     std::unique_ptr<render::CameraRenderer> renderer;
-    std::int64_t period_us = 0;
-    std::int64_t next_due_utime = -1;
+    std::int64_t next_due_utime = core::kDueAtFirstCall;
   };
   std::map<std::string, CameraSpec> specs_;
   std::map<std::string, Camera> cameras_;

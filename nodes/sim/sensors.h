@@ -20,24 +20,13 @@
 
 #include <Eigen/Core>
 
+#include "core/clock.h"
 #include "core/geodesy.h"
 #include "core/params.h"
 #include "nodes/sim/vehicle_state.h"
 #include "terrain/world.h"
 
 namespace nadir::sim {
-
-// Initial value of a next_due_utime for due(): the first call is due.
-inline constexpr std::int64_t kDueAtFirstCall = std::numeric_limits<std::int64_t>::min();
-
-// Fixed-grid sampling in message time. The first call (next_due_utime ==
-// kDueAtFirstCall) is due and anchors the grid at utime; after that a call is
-// due when utime has reached next_due_utime, and due times advance on the grid
-// anchor + k * period, period = 1e6 / rate_hz rounded to whole microseconds
-// (at least 1). If utime skips grid points, one sample is due and the next due
-// time is the first grid point after utime: the grid never drifts. Throws
-// std::invalid_argument if rate_hz is not positive and finite.
-bool due(std::int64_t utime, double rate_hz, std::int64_t& next_due_utime);
 
 // Gaussian noise source: std::mt19937_64 and Box-Muller, identical on every
 // platform's standard library (up to the last bit of std::log/std::cos).

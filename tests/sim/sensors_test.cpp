@@ -13,6 +13,9 @@
 namespace nadir::sim {
 namespace {
 
+using core::due;
+using core::kDueAtFirstCall;
+
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kG = 9.80665;
