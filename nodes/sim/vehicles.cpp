@@ -28,13 +28,6 @@ Eigen::Vector3d bodyRates(const core::RollPitchYaw& rpy, double roll_dot, double
 
 std::int64_t stepMicroseconds(double step_s) { return std::llround(step_s * 1e6); }
 
-// Gaussian from two uniforms (Box-Muller): the same on every standard library.
-double gaussian(std::mt19937_64& random) {
-  const double u1 = (static_cast<double>(random() >> 11) + 0.5) * 0x1.0p-53;
-  const double u2 = (static_cast<double>(random() >> 11) + 0.5) * 0x1.0p-53;
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
-}
-
 }  // namespace
 
 void FixedWingParams::visit(core::ParamVisitor& v) {
@@ -65,7 +58,7 @@ FixedWing::FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start
       waypoints_(std::move(waypoints_ned)),
       leg_start_ned_(start_ned),
       heading_rad_(heading_rad),
-      random_(static_cast<std::uint64_t>(params.seed)) {
+      noise_(static_cast<std::uint64_t>(params.seed)) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
   if (waypoints_.empty()) throw std::invalid_argument("the fixed-wing has no waypoint to fly to");
   // Two waypoints closer than a full turn cannot both be flown through.
@@ -158,8 +151,9 @@ void FixedWing::step() {
   if (params_.turbulence_mps > 0.0) {
     const double tau = params_.turbulence_time_constant_s;
     for (int i = 0; i < 3; ++i) {
-      gust_ned_mps_[i] += -gust_ned_mps_[i] / tau * dt +
-                          params_.turbulence_mps * std::sqrt(2.0 * dt / tau) * gaussian(random_);
+      gust_ned_mps_[i] += -gust_ned_mps_[i] / tau * dt + params_.turbulence_mps *
+                                                             std::sqrt(2.0 * dt / tau) *
+                                                             noise_.standardNormal();
     }
   }
   const Eigen::Vector3d air_velocity =

@@ -4,12 +4,12 @@
 // (local NED) and exposes its true state. No LCM here.
 
 #include <cstdint>
-#include <random>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "core/params.h"
+#include "nodes/sim/noise.h"
 #include "nodes/sim/vehicle_state.h"
 
 namespace nadir::sim {
@@ -64,7 +64,7 @@ class FixedWing {
   double bank_rad_ = 0.0;
   double climb_rate_mps_ = 0.0;
   Eigen::Vector3d gust_ned_mps_ = Eigen::Vector3d::Zero();
-  std::mt19937_64 random_;
+  GaussianNoise noise_;
 };
 
 // Multirotor: flies each leg at a set speed with limited acceleration,
