@@ -15,7 +15,6 @@
 
 #include <cstdint>
 #include <limits>
-#include <random>
 #include <vector>
 
 #include <Eigen/Core>
