@@ -426,10 +426,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
   for (const terrain::TileId& id : visible) {
     const auto geometry = tiles_->geometry(id);
     const terrain::GroundSquare& sq = geometry->square;
-    const Eigen::Vector3d box_min(sq.north_min_m, sq.east_min_m, -geometry->max_up_m);
-    const Eigen::Vector3d box_max(sq.north_min_m + sq.size_m, sq.east_min_m + sq.size_m,
-                                  -geometry->min_up_m);
-    const double nearest_m = (camera_ned.cwiseMax(box_min).cwiseMin(box_max) - camera_ned).norm();
+    const double nearest_m = geometry->distanceFrom_m(camera_ned);
     const double texel_m = sq.size_m / tiles_->params().texture_px;
     (view.ground_detail && texel_m > nearest_m / focal_px ? detailed : plain).push_back(id);
   }

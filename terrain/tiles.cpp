@@ -15,6 +15,19 @@ std::uint64_t TileId::key() const {
          static_cast<std::uint64_t>(iy);
 }
 
+Eigen::Vector3d TileGeometry::boxMin() const {
+  return {square.north_min_m, square.east_min_m, -static_cast<double>(max_up_m)};
+}
+
+Eigen::Vector3d TileGeometry::boxMax() const {
+  return {square.north_min_m + square.size_m, square.east_min_m + square.size_m,
+          -static_cast<double>(min_up_m)};
+}
+
+double TileGeometry::distanceFrom_m(const Eigen::Vector3d& p_ned) const {
+  return (p_ned.cwiseMax(boxMin()).cwiseMin(boxMax()) - p_ned).norm();
+}
+
 void TileParams::visit(core::ParamVisitor& v) {
   v.field("mesh_quads", &mesh_quads, {.doc = "mesh quads along a tile edge", .min = 1, .max = 256});
   v.field("texture_px", &texture_px,
@@ -145,9 +158,8 @@ std::vector<TileId> TileTree::select(const LodView& view) {
 void TileTree::selectInto(const TileId& id, const LodView& view, std::vector<TileId>& out) {
   const std::shared_ptr<const TileGeometry> tile = geometry(id);
   const GroundSquare& sq = tile->square;
-  const Eigen::Vector3d box_min(sq.north_min_m, sq.east_min_m, -tile->max_up_m);
-  const Eigen::Vector3d box_max(sq.north_min_m + sq.size_m, sq.east_min_m + sq.size_m,
-                                -tile->min_up_m);
+  const Eigen::Vector3d box_min = tile->boxMin();
+  const Eigen::Vector3d box_max = tile->boxMax();
   for (const Eigen::Vector4d& plane : view.frustum_planes) {
     // The box corner furthest along the plane's normal; if even it is outside, so is the box.
     const Eigen::Vector3d corner((plane.x() >= 0 ? box_max : box_min).x(),
@@ -155,8 +167,7 @@ void TileTree::selectInto(const TileId& id, const LodView& view, std::vector<Til
                                  (plane.z() >= 0 ? box_max : box_min).z());
     if (plane.head<3>().dot(corner) + plane.w() < 0.0) return;
   }
-  const Eigen::Vector3d nearest = view.camera_ned.cwiseMax(box_min).cwiseMin(box_max);
-  const double distance_m = std::max((nearest - view.camera_ned).norm(), 1e-3);
+  const double distance_m = std::max(tile->distanceFrom_m(view.camera_ned), 1e-3);
   const double pixels_per_m = view.focal_px / distance_m;
   const double texel_m = sq.size_m / params_.texture_px;
   const bool too_coarse = tile->geometric_error_m * pixels_per_m > params_.max_geometric_error_px ||

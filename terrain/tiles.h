@@ -57,6 +57,12 @@ struct TileGeometry {
   float max_up_m = 0.0f;
   // Largest height difference between the mesh and the ground between its vertices, m.
   float geometric_error_m = 0.0f;
+
+  // Corners of the tile's bounding box in the world frame (NED).
+  Eigen::Vector3d boxMin() const;
+  Eigen::Vector3d boxMax() const;
+  // Distance from a point to the nearest point of that box, m (0 inside).
+  double distanceFrom_m(const Eigen::Vector3d& p_ned) const;
 };
 
 // A view for tile selection: camera centre, frustum planes (inward normals,
