@@ -26,6 +26,12 @@ std::string formatNumber(double value) {
   return std::string(text, result.ptr);
 }
 
+std::string formatList(const std::vector<double>& values) {
+  std::string list = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) list += (i ? ", " : "") + formatNumber(values[i]);
+  return list + "]";
+}
+
 std::string describeRange(const ParamSpec& spec) {
   return "[" + formatNumber(spec.min) + ", " + formatNumber(spec.max) + "]";
 }
@@ -71,6 +77,27 @@ void checkValue(const ParamRef& ref, const ParamSpec& spec, const std::string& w
             }
             for (double value : *values) checkNumber(value, spec, where, key);
           },
+          [&](NumberRows* rows) {
+            if (spec.list_size != 0 && rows->size() != spec.list_size) {
+              fail(where, key,
+                   "expected " + std::to_string(spec.list_size) + " rows, got " +
+                       std::to_string(rows->size()));
+            }
+            for (std::size_t i = 0; i < rows->size(); ++i) {
+              const std::vector<double>& row = (*rows)[i];
+              const std::string row_key = key + "[" + std::to_string(i) + "]";
+              if (!spec.row_sizes.empty() && std::find(spec.row_sizes.begin(), spec.row_sizes.end(),
+                                                       row.size()) == spec.row_sizes.end()) {
+                std::string allowed;
+                for (std::size_t size : spec.row_sizes) {
+                  allowed += (allowed.empty() ? "" : " or ") + std::to_string(size);
+                }
+                fail(where, row_key,
+                     "expected " + allowed + " numbers, got " + std::to_string(row.size()));
+              }
+              for (double value : row) checkNumber(value, spec, where, row_key);
+            }
+          },
       },
       ref);
 }
@@ -83,6 +110,7 @@ const char* typeName(const ParamRef& ref) {
                         [](double*) { return "a number"; },
                         [](std::string*) { return "a string"; },
                         [](std::vector<double>*) { return "a list of numbers"; },
+                        [](NumberRows*) { return "a list of lists of numbers"; },
                     },
                     ref);
 }
@@ -99,6 +127,7 @@ void convertInto(const YAML::Node& node, const ParamRef& ref) {
                    *value = node.as<std::string>();
                  },
                  [&](std::vector<double>* value) { *value = node.as<std::vector<double>>(); },
+                 [&](NumberRows* value) { *value = node.as<NumberRows>(); },
              },
              ref);
 }
@@ -298,12 +327,13 @@ class Formatter final : public ParamVisitor {
                             emitter << YAML::DoubleQuoted << *value;
                             return std::string(emitter.c_str());
                           },
-                          [](std::vector<double>* values) {
-                            std::string list = "[";
-                            for (std::size_t i = 0; i < values->size(); ++i) {
-                              list += (i ? ", " : "") + formatNumber((*values)[i]);
+                          [](std::vector<double>* values) { return formatList(*values); },
+                          [](NumberRows* rows) {
+                            std::string table = "[";
+                            for (std::size_t i = 0; i < rows->size(); ++i) {
+                              table += (i ? ", " : "") + formatList((*rows)[i]);
                             }
-                            return list + "]";
+                            return table + "]";
                           },
                       },
                       ref);

@@ -39,10 +39,15 @@ struct ParamSpec {
   std::vector<std::string_view> choices = {};
   // Required length of a list field; 0 allows any.
   std::size_t list_size = 0;
+  // A list of rows (a table): the allowed lengths of each row; empty allows any.
+  std::vector<std::size_t> row_sizes = {};
 };
 
-using ParamRef =
-    std::variant<bool*, int*, std::int64_t*, double*, std::string*, std::vector<double>*>;
+// A table of numbers, YAML `[[1, 2], [3, 4, 5]]`: waypoints and the like.
+using NumberRows = std::vector<std::vector<double>>;
+
+using ParamRef = std::variant<bool*, int*, std::int64_t*, double*, std::string*,
+                              std::vector<double>*, NumberRows*>;
 
 // Access to a map of named entries of one params struct (see visitGroupMap).
 struct GroupMapAccess {

@@ -624,5 +624,43 @@ TEST(ParamsGroupMap, FormatRoundTrip) {
   EXPECT_EQ(formatParamsOf(copy), formatParamsOf(rig));
 }
 
+struct RouteParams {
+  NumberRows waypoints = {{0.0, 0.0}};
+  void visit(ParamVisitor& v) {
+    v.field("waypoints", &waypoints,
+            {.doc = "north, east[, height]", .min = -1000, .max = 1000, .row_sizes = {2, 3}});
+  }
+};
+
+// A table of numbers loads row by row; rows of an allowed length may differ in length.
+TEST(ParamsRows, TableLoadsAndRoundTrips) {
+  RouteParams params;
+  const auto visit = [&params](ParamVisitor& v) { params.visit(v); };
+  applyYamlText("waypoints: [[1, 2], [3.5, -4, 10]]\n", "route.yaml", visit);
+  ASSERT_EQ(params.waypoints.size(), 2u);
+  EXPECT_EQ(params.waypoints[0], (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(params.waypoints[1], (std::vector<double>{3.5, -4.0, 10.0}));
+  EXPECT_EQ(formatParamsOf(params),
+            "waypoints: [[1, 2], [3.5, -4, 10]]  # north, east[, height]\n");
+  applyAssignment("waypoints=[[7, 8]]", "--set", visit);
+  EXPECT_EQ(params.waypoints, (NumberRows{{7.0, 8.0}}));
+}
+
+// A row of the wrong length, a value out of range or a flat list is refused with the row named.
+TEST(ParamsRows, BadRowsAreRefusedAndChangeNothing) {
+  RouteParams params;
+  const auto visit = [&params](ParamVisitor& v) { params.visit(v); };
+  std::string message =
+      paramErrorOf([&] { applyYamlText("waypoints: [[1, 2], [3]]\n", "route.yaml", visit); });
+  EXPECT_TRUE(startsWith(message, "route.yaml:1: waypoints[1]: expected 2 or 3 numbers, got 1"))
+      << message;
+  message =
+      paramErrorOf([&] { applyYamlText("waypoints: [[1, 2], [3, 2000]]\n", "route.yaml", visit); });
+  EXPECT_TRUE(contains(message, "waypoints[1]: 2000 is out of range")) << message;
+  message = paramErrorOf([&] { applyYamlText("waypoints: [1, 2]\n", "route.yaml", visit); });
+  EXPECT_TRUE(contains(message, "expected a list of lists of numbers")) << message;
+  EXPECT_EQ(params.waypoints, (NumberRows{{0.0, 0.0}}));
+}
+
 }  // namespace
 }  // namespace nadir::core
