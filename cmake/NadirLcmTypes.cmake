@@ -26,4 +26,8 @@ function(nadir_add_lcmtypes target)
   add_dependencies(${target} ${target}_gen)
   target_include_directories(${target} SYSTEM INTERFACE ${include_dir})
   target_link_libraries(${target} INTERFACE PkgConfig::LCM)
+  # LCM 1.3.1's lcm_coretypes.h decodes doubles through an int64_t* cast. With
+  # strict aliasing, -O3 can keep a field's value from before decode() (seen on
+  # geodetic_position_t), so every user of the generated types compiles without it.
+  target_compile_options(${target} INTERFACE -fno-strict-aliasing)
 endfunction()

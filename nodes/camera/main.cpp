@@ -2,6 +2,7 @@
 // arrives over LCM, and publishes their images and camera_info_t. Wiring only.
 //
 //   nadir-camera [--config FILE] [--set key=value ...]
+//   nadir-camera --scenario NAME [--set key=value ...]   (the scenario's world and cameras)
 
 #include <CLI/CLI.hpp>
 
@@ -15,6 +16,7 @@
 #include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
 #include "nodes/camera/ground_scene.h"
+#include "scenario/scenario.h"
 
 namespace {
 
@@ -27,16 +29,34 @@ void onSignal(int) { g_stop = true; }
 int main(int argc, char** argv) {
   CLI::App app{"nadir-camera: virtual downward cameras over LCM"};
   std::string config_path;
+  std::string scenario_name;
   std::vector<std::string> overrides;
-  app.add_option("--config", config_path, "YAML parameter file")->check(CLI::ExistingFile);
+  auto* config =
+      app.add_option("--config", config_path, "YAML parameter file")->check(CLI::ExistingFile);
+  app.add_option("--scenario", scenario_name,
+                 "take the world, cameras, targets and bus from this scenario (--set applies "
+                 "to the scenario's keys)")
+      ->excludes(config);
   app.add_option("--set", overrides, "override a parameter: key=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
 
   try {
     nadir::camera::CameraNodeParams params;
-    const auto visit = [&params](nadir::core::ParamVisitor& v) { params.visit(v); };
-    if (!config_path.empty()) nadir::core::applyYamlFile(config_path, visit);
-    nadir::core::applyAssignments(params, overrides);
+    if (!scenario_name.empty()) {
+      const nadir::scenario::ScenarioParams scenario =
+          nadir::scenario::loadScenario(scenario_name, overrides);
+      params.bus = scenario.bus;
+      params.pose_channel = scenario.sim.truth.channel;
+      params.world = scenario.world;
+      params.tiles = scenario.tiles;
+      params.renderer = scenario.renderer;
+      params.cameras = scenario.allCameras();
+      params.targets = scenario.targets;
+    } else {
+      const auto visit = [&params](nadir::core::ParamVisitor& v) { params.visit(v); };
+      if (!config_path.empty()) nadir::core::applyYamlFile(config_path, visit);
+      nadir::core::applyAssignments(params, overrides);
+    }
     if (params.cameras.empty()) params.cameras["down"] = nadir::camera::CameraSpec{};
     std::cout << "nadir-camera parameters:\n" << nadir::core::formatParamsOf(params) << std::flush;
 

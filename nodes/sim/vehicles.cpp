@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,8 @@ namespace nadir::sim {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
+// Turns sharper than this (160 deg) are anticipated as if they were this sharp.
+constexpr double kMaxAnticipatedTurn_rad = 2.8;
 
 double wrapAngle(double angle_rad) { return std::remainder(angle_rad, 2.0 * std::numbers::pi); }
 
@@ -26,9 +29,46 @@ Eigen::Vector3d bodyRates(const core::RollPitchYaw& rpy, double roll_dot, double
           -pitch_dot * sr + yaw_dot * cr * cp};
 }
 
+// One decimal, for messages.
+std::string decimal(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f", value);
+  return text;
+}
+
 std::int64_t stepMicroseconds(double step_s) { return std::llround(step_s * 1e6); }
 
+// step_s is set by the simulator, not visited with the other parameters.
+void checkStep(double step_s) {
+  if (!(step_s >= 1e-5 && step_s <= 0.1)) {
+    throw core::ParamError("vehicle: integration step " + std::to_string(step_s) +
+                           " s is out of range [1e-05, 0.1]");
+  }
+}
+
+double speedOf(const std::vector<Waypoint>& waypoints, std::size_t i, double cruise_mps) {
+  const std::size_t last = waypoints.size() - 1;
+  const double speed = waypoints[std::min(i, last)].speed_mps;
+  return speed > 0.0 ? speed : cruise_mps;
+}
+
+void checkWaypointSpeeds(const std::vector<Waypoint>& waypoints) {
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    if (!(waypoints[i].speed_mps >= 0.0) || !std::isfinite(waypoints[i].speed_mps) ||
+        !waypoints[i].p_ned_m.allFinite()) {
+      throw std::invalid_argument("waypoint " + std::to_string(i + 1) +
+                                  " has a non-finite position or a negative speed");
+    }
+  }
+}
+
 }  // namespace
+
+std::vector<Waypoint> waypointsAt(const std::vector<Eigen::Vector3d>& points_ned_m) {
+  std::vector<Waypoint> waypoints;
+  for (const Eigen::Vector3d& p : points_ned_m) waypoints.push_back({p, 0.0});
+  return waypoints;
+}
 
 void FixedWingParams::visit(core::ParamVisitor& v) {
   v.field("airspeed_mps", &airspeed_mps, {.doc = "true airspeed, m/s", .min = 1, .max = 300});
@@ -49,47 +89,72 @@ void FixedWingParams::visit(core::ParamVisitor& v) {
   v.field("turbulence_time_constant_s", &turbulence_time_constant_s,
           {.doc = "correlation time of the gusts, s", .min = 0.01, .max = 600});
   v.field("seed", &seed, {.doc = "seed of the turbulence"});
-  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
+  v.field(
+      "max_acceleration_mps2", &max_acceleration_mps2,
+      {.doc = "airspeed change between legs of different speeds, m/s^2", .min = 0.01, .max = 50});
 }
 
 FixedWing::FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start_ned,
-                     double heading_rad, std::vector<Eigen::Vector3d> waypoints_ned)
+                     double heading_rad, std::vector<Waypoint> waypoints)
     : params_(params),
-      waypoints_(std::move(waypoints_ned)),
+      waypoints_(std::move(waypoints)),
       leg_start_ned_(start_ned),
       heading_rad_(heading_rad),
       noise_(static_cast<std::uint64_t>(params.seed)) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  checkStep(params_.step_s);
   if (waypoints_.empty()) throw std::invalid_argument("the fixed-wing has no waypoint to fly to");
-  // Two waypoints closer than a full turn cannot both be flown through.
-  const double min_leg_m = 2.0 * minimumTurnRadius_m();
-  Eigen::Vector3d previous = start_ned;
+  checkWaypointSpeeds(waypoints_);
+  // Each turn starts a lead distance r tan(turn / 2) before its waypoint (see
+  // step()); a leg too short for the leads of the turns at both its ends
+  // cannot be flown through.
+  const auto turnAt = [this, &start_ned](std::size_t i) {
+    if (i + 1 >= waypoints_.size()) return 0.0;
+    const Eigen::Vector3d& from = i == 0 ? start_ned : waypoints_[i - 1].p_ned_m;
+    const Eigen::Vector2d in = horizontal(waypoints_[i].p_ned_m) - horizontal(from);
+    const Eigen::Vector2d out =
+        horizontal(waypoints_[i + 1].p_ned_m) - horizontal(waypoints_[i].p_ned_m);
+    return std::abs(wrapAngle(std::atan2(out.y(), out.x()) - std::atan2(in.y(), in.x())));
+  };
   for (std::size_t i = 0; i < waypoints_.size(); ++i) {
-    const double leg_m = (horizontal(waypoints_[i]) - horizontal(previous)).norm();
-    if (leg_m < min_leg_m) {
-      throw std::invalid_argument(
-          "waypoint " + std::to_string(i + 1) + " is " + std::to_string(leg_m) +
-          " m from the one before: the aircraft needs at least " + std::to_string(min_leg_m) +
-          " m (two turn radii at " + std::to_string(params_.airspeed_mps) + " m/s and " +
-          std::to_string(params_.max_bank_deg) + " deg bank)");
+    const Eigen::Vector3d& from = i == 0 ? start_ned : waypoints_[i - 1].p_ned_m;
+    const double leg_m = (horizontal(waypoints_[i].p_ned_m) - horizontal(from)).norm();
+    const double speed_mps = std::max(legSpeed_mps(i), legSpeed_mps(i + 1));
+    const double radius_m = turnRadius_m(speed_mps);
+    const double lead_in_m =
+        i == 0 ? 0.0 : radius_m * std::tan(0.5 * std::min(turnAt(i - 1), kMaxAnticipatedTurn_rad));
+    const double lead_out_m =
+        radius_m * std::tan(0.5 * std::min(turnAt(i), kMaxAnticipatedTurn_rad));
+    if (leg_m < lead_in_m + lead_out_m) {
+      throw std::invalid_argument("waypoint " + std::to_string(i + 1) + " is " + decimal(leg_m) +
+                                  " m from the one before: the turns at the ends of that leg "
+                                  "need " +
+                                  decimal(lead_in_m + lead_out_m) + " m at " + decimal(speed_mps) +
+                                  " m/s and " + decimal(params_.max_bank_deg) + " deg bank");
     }
-    previous = waypoints_[i];
   }
+  airspeed_mps_ = legSpeed_mps(0);
   state_.p_ned_m = start_ned;
   state_.v_ned_mps =
-      params_.airspeed_mps * Eigen::Vector3d(std::cos(heading_rad), std::sin(heading_rad), 0.0) +
+      airspeed_mps_ * Eigen::Vector3d(std::cos(heading_rad), std::sin(heading_rad), 0.0) +
       Eigen::Vector3d(params_.wind_ned_mps[0], params_.wind_ned_mps[1], params_.wind_ned_mps[2]);
   state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
 }
 
-double FixedWing::minimumTurnRadius_m() const {
-  return params_.airspeed_mps * params_.airspeed_mps /
-         (kGravity_mps2 * std::tan(params_.max_bank_deg * kDeg));
+double FixedWing::turnRadius_m(double airspeed_mps) const {
+  return airspeed_mps * airspeed_mps / (kGravity_mps2 * std::tan(params_.max_bank_deg * kDeg));
+}
+
+double FixedWing::legSpeed_mps(std::size_t waypoint) const {
+  return speedOf(waypoints_, waypoint, params_.airspeed_mps);
 }
 
 void FixedWing::step() {
   const double dt = params_.step_s;
-  const double airspeed = params_.airspeed_mps;
+  const double max_speed_step = params_.max_acceleration_mps2 * dt;
+  airspeed_mps_ +=
+      std::clamp(legSpeed_mps(next_waypoint_) - airspeed_mps_, -max_speed_step, max_speed_step);
+  const double airspeed = airspeed_mps_;
   const double max_bank = params_.max_bank_deg * kDeg;
   const Eigen::Vector3d p = state_.p_ned_m;
 
@@ -98,18 +163,19 @@ void FixedWing::step() {
   double bank_command = 0.0;
   double altitude_target_m = -p.z();
   if (!finished()) {
-    const Eigen::Vector3d& target = waypoints_[next_waypoint_];
+    const Eigen::Vector3d& target = waypoints_[next_waypoint_].p_ned_m;
     const Eigen::Vector2d leg = horizontal(target) - horizontal(leg_start_ned_);
     const Eigen::Vector2d leg_unit = leg.normalized();
     const double along_m = (horizontal(p) - horizontal(leg_start_ned_)).dot(leg_unit);
     double lead_m = 0.0;
     if (next_waypoint_ + 1 < waypoints_.size()) {
       const Eigen::Vector2d next_leg =
-          horizontal(waypoints_[next_waypoint_ + 1]) - horizontal(target);
+          horizontal(waypoints_[next_waypoint_ + 1].p_ned_m) - horizontal(target);
       const double turn_rad = std::abs(
           wrapAngle(std::atan2(next_leg.y(), next_leg.x()) - std::atan2(leg.y(), leg.x())));
-      lead_m = std::min(minimumTurnRadius_m() * std::tan(0.5 * std::min(turn_rad, 2.8)),
-                        0.5 * leg.norm());
+      lead_m = std::min(
+          turnRadius_m(airspeed) * std::tan(0.5 * std::min(turn_rad, kMaxAnticipatedTurn_rad)),
+          0.5 * leg.norm());
     }
     if (along_m >= leg.norm() - lead_m) {
       leg_start_ned_ = target;
@@ -117,7 +183,7 @@ void FixedWing::step() {
     }
   }
   if (!finished()) {
-    const Eigen::Vector3d& target = waypoints_[next_waypoint_];
+    const Eigen::Vector3d& target = waypoints_[next_waypoint_].p_ned_m;
     altitude_target_m = -target.z();
     const Eigen::Vector2d leg_unit = (horizontal(target) - horizontal(leg_start_ned_)).normalized();
     const Eigen::Vector2d from_start = horizontal(p) - horizontal(leg_start_ned_);
@@ -180,14 +246,15 @@ void MultirotorParams::visit(core::ParamVisitor& v) {
           {.doc = "yaw rate when turning, deg/s", .min = 1, .max = 720});
   v.field("yaw_at_corners", &yaw_at_corners,
           {.doc = "stop and turn to face each new leg (else keep the start heading)"});
-  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
 }
 
 Multirotor::Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned,
-                       double heading_rad, std::vector<Eigen::Vector3d> waypoints_ned)
-    : params_(params), waypoints_(std::move(waypoints_ned)), yaw_rad_(heading_rad) {
+                       double heading_rad, std::vector<Waypoint> waypoints)
+    : params_(params), waypoints_(std::move(waypoints)), yaw_rad_(heading_rad) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  checkStep(params_.step_s);
   if (waypoints_.empty()) throw std::invalid_argument("the multirotor has no waypoint to fly to");
+  checkWaypointSpeeds(waypoints_);
   state_.p_ned_m = start_ned;
   state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
 }
@@ -199,7 +266,7 @@ void Multirotor::step() {
   double yaw_rate_rps = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   if (!finished()) {
-    const Eigen::Vector3d to_target = waypoints_[next_waypoint_] - state_.p_ned_m;
+    const Eigen::Vector3d to_target = waypoints_[next_waypoint_].p_ned_m - state_.p_ned_m;
     const double distance_m = to_target.norm();
     const double leg_course = std::atan2(to_target.y(), to_target.x());
     const double yaw_error = wrapAngle(leg_course - yaw_rad_);
@@ -212,7 +279,8 @@ void Multirotor::step() {
       yaw_rate_rps = yaw_step / dt;
     } else {
       // Accelerate to cruise, brake so as to stop on the waypoint.
-      speed_mps_ = std::min({speed_mps_ + params_.acceleration_mps2 * dt, params_.speed_mps,
+      speed_mps_ = std::min({speed_mps_ + params_.acceleration_mps2 * dt,
+                             speedOf(waypoints_, next_waypoint_, params_.speed_mps),
                              std::sqrt(2.0 * params_.acceleration_mps2 * distance_m)});
       if (distance_m <= speed_mps_ * dt || distance_m < 1e-9) {
         velocity = to_target / dt;
@@ -251,14 +319,15 @@ void RoverParams::visit(core::ParamVisitor& v) {
           {.doc = "pure pursuit lookahead, m", .min = 0.01, .max = 100});
   v.field("arrival_radius_m", &arrival_radius_m,
           {.doc = "a waypoint is reached within this distance, m", .min = 0.001, .max = 100});
-  v.field("step_s", &step_s, {.doc = "integration step, s", .min = 1e-5, .max = 0.1});
 }
 
 Rover::Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
-             std::vector<Eigen::Vector3d> waypoints_ned)
-    : params_(params), waypoints_(std::move(waypoints_ned)), heading_rad_(heading_rad) {
+             std::vector<Waypoint> waypoints)
+    : params_(params), waypoints_(std::move(waypoints)), heading_rad_(heading_rad) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  checkStep(params_.step_s);
   if (waypoints_.empty()) throw std::invalid_argument("the rover has no waypoint to drive to");
+  checkWaypointSpeeds(waypoints_);
   state_.p_ned_m = start_ned;
   state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
 }
@@ -268,15 +337,16 @@ void Rover::step() {
   const Eigen::Vector3d previous_velocity = state_.v_ned_mps;
   double speed = 0.0;
   double steer_command = 0.0;
-  if (!finished() && (horizontal(waypoints_[next_waypoint_]) - horizontal(state_.p_ned_m)).norm() <=
-                         params_.arrival_radius_m) {
+  if (!finished() &&
+      (horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m)).norm() <=
+          params_.arrival_radius_m) {
     ++next_waypoint_;
   }
   if (!finished()) {
-    speed = params_.speed_mps;
+    speed = speedOf(waypoints_, next_waypoint_, params_.speed_mps);
     // Pure pursuit: the arc through the goal point ahead, curvature 2 sin(alpha) / L.
     const Eigen::Vector2d to_goal =
-        horizontal(waypoints_[next_waypoint_]) - horizontal(state_.p_ned_m);
+        horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m);
     const double alpha = wrapAngle(std::atan2(to_goal.y(), to_goal.x()) - heading_rad_);
     const double distance = std::max(std::min(to_goal.norm(), params_.lookahead_m), 1e-6);
     // A goal behind gets the tightest turn towards it, not none.

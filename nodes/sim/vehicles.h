@@ -14,6 +14,15 @@
 
 namespace nadir::sim {
 
+// A point in the world frame (local NED) to go to, and the speed on the leg
+// that ends there; 0 takes the vehicle's cruise speed.
+struct Waypoint {
+  Eigen::Vector3d p_ned_m = Eigen::Vector3d::Zero();
+  double speed_mps = 0.0;
+};
+
+std::vector<Waypoint> waypointsAt(const std::vector<Eigen::Vector3d>& points_ned_m);
+
 // Fixed-wing aircraft in coordinated flight: constant airspeed, turn rate
 // g tan(bank) / airspeed, bank limited in angle and rate, climb rate limited,
 // waypoints followed along their legs with turn anticipation, optional
@@ -30,6 +39,9 @@ struct FixedWingParams {
   double turbulence_mps = 0.0;
   double turbulence_time_constant_s = 2.0;
   std::int64_t seed = 1;
+  // Rate of an airspeed change between legs of different speeds, m/s^2.
+  double max_acceleration_mps2 = 1.0;
+  // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
 
   void visit(core::ParamVisitor& v);
@@ -39,9 +51,14 @@ class FixedWing {
  public:
   // Starts at start_ned, flying level along heading_rad, towards the waypoints.
   // Throws std::invalid_argument for an empty waypoint list or a waypoint the
-  // aircraft cannot reach (closer to the previous one than twice the minimum turn radius).
+  // aircraft cannot fly through: a leg shorter than the turns at its two ends
+  // need (r tan(turn / 2) each, r the turn radius at the maximum bank and the
+  // faster of the adjoining legs' speeds).
   FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
-            std::vector<Eigen::Vector3d> waypoints_ned);
+            std::vector<Waypoint> waypoints);
+  FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+            const std::vector<Eigen::Vector3d>& waypoints_ned)
+      : FixedWing(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
 
   // Advances one step of params.step_s.
   void step();
@@ -50,18 +67,23 @@ class FixedWing {
   bool finished() const { return next_waypoint_ >= waypoints_.size(); }
   double bank_rad() const { return bank_rad_; }
   double heading_rad() const { return heading_rad_; }
+  double airspeed_mps() const { return airspeed_mps_; }
   std::size_t nextWaypoint() const { return next_waypoint_; }
-  // Radius of a turn at the maximum bank, m.
-  double minimumTurnRadius_m() const;
+  // Radius of a turn at the maximum bank and params.airspeed_mps, m.
+  double minimumTurnRadius_m() const { return turnRadius_m(params_.airspeed_mps); }
 
  private:
+  double turnRadius_m(double airspeed_mps) const;
+  double legSpeed_mps(std::size_t waypoint) const;
+
   FixedWingParams params_;
-  std::vector<Eigen::Vector3d> waypoints_;
+  std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   Eigen::Vector3d leg_start_ned_;
   VehicleState state_;
   double heading_rad_ = 0.0;
   double bank_rad_ = 0.0;
+  double airspeed_mps_ = 0.0;
   double climb_rate_mps_ = 0.0;
   Eigen::Vector3d gust_ned_mps_ = Eigen::Vector3d::Zero();
   GaussianNoise noise_;
@@ -76,6 +98,7 @@ struct MultirotorParams {
   double acceleration_mps2 = 1.5;
   double yaw_rate_dps = 45.0;
   bool yaw_at_corners = true;
+  // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
 
   void visit(core::ParamVisitor& v);
@@ -84,7 +107,10 @@ struct MultirotorParams {
 class Multirotor {
  public:
   Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
-             std::vector<Eigen::Vector3d> waypoints_ned);
+             std::vector<Waypoint> waypoints);
+  Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+             const std::vector<Eigen::Vector3d>& waypoints_ned)
+      : Multirotor(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
   void step();
   const VehicleState& state() const { return state_; }
   bool finished() const { return next_waypoint_ >= waypoints_.size(); }
@@ -92,7 +118,7 @@ class Multirotor {
 
  private:
   MultirotorParams params_;
-  std::vector<Eigen::Vector3d> waypoints_;
+  std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   VehicleState state_;
   double yaw_rad_ = 0.0;
@@ -110,6 +136,7 @@ struct RoverParams {
   double lookahead_m = 1.0;
   // A waypoint counts as reached within this distance.
   double arrival_radius_m = 0.2;
+  // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
 
   void visit(core::ParamVisitor& v);
@@ -118,7 +145,10 @@ struct RoverParams {
 class Rover {
  public:
   Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
-        std::vector<Eigen::Vector3d> waypoints_ned);
+        std::vector<Waypoint> waypoints);
+  Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
+        const std::vector<Eigen::Vector3d>& waypoints_ned)
+      : Rover(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
   void step();
   const VehicleState& state() const { return state_; }
   bool finished() const { return next_waypoint_ >= waypoints_.size(); }
@@ -127,7 +157,7 @@ class Rover {
 
  private:
   RoverParams params_;
-  std::vector<Eigen::Vector3d> waypoints_;
+  std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   VehicleState state_;
   double heading_rad_ = 0.0;

@@ -14,7 +14,11 @@
 
 #include <gtest/gtest.h>
 
+#include "nadir/attitude_t.hpp"
+#include "nadir/baro_t.hpp"
+#include "nadir/body_rates_t.hpp"
 #include "nadir/camera_info_t.hpp"
+#include "nadir/geodetic_position_t.hpp"
 #include "nadir/gps_t.hpp"
 #include "nadir/image_metadata_t.hpp"
 #include "nadir/image_t.hpp"
@@ -23,6 +27,7 @@
 #include "nadir/ppa_odometry_t.hpp"
 #include "nadir/range_t.hpp"
 #include "nadir/target_detection_t.hpp"
+#include "nadir/velocity_t.hpp"
 #include "nadir/vo_command_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
 
@@ -387,6 +392,82 @@ TEST(LcmTypesRoundTrip, VoCommand) {
   EXPECT_EQ(decoded.command, -5);
   EXPECT_EQ(decoded.has_initial_pose, 1);
   ExpectPoseEq(MakePose(INT64_C(9'000'000'000'019), 30.0), decoded.initial_pose);
+}
+
+// baro_t: every field survives encode/decode.
+TEST(LcmTypesRoundTrip, Baro) {
+  nadir::baro_t msg{};
+  msg.utime = INT64_C(1'700'000'000'000'003);
+  msg.altitude_m = -412.25;  // Below the ellipsoid (the Dead Sea shore).
+  msg.pressure_pa = 106454.3;
+
+  const nadir::baro_t decoded = RoundTrip(msg);
+  EXPECT_EQ(decoded.utime, INT64_C(1'700'000'000'000'003));
+  EXPECT_EQ(decoded.altitude_m, -412.25);
+  EXPECT_EQ(decoded.pressure_pa, 106454.3);
+}
+
+// geodetic_position_t: every field survives encode/decode, including a negative relative altitude.
+TEST(LcmTypesRoundTrip, GeodeticPosition) {
+  nadir::geodetic_position_t msg{};
+  msg.utime = INT64_C(1'700'000'000'000'005);
+  msg.latitude_rad = -0.5931997761031083;
+  msg.longitude_rad = 2.6297467049469577;
+  msg.altitude_m = 1523.875;
+  msg.altitude_rel_m = -3.125;
+
+  const nadir::geodetic_position_t decoded = RoundTrip(msg);
+  EXPECT_EQ(decoded.utime, INT64_C(1'700'000'000'000'005));
+  EXPECT_EQ(decoded.latitude_rad, -0.5931997761031083);
+  EXPECT_EQ(decoded.longitude_rad, 2.6297467049469577);
+  EXPECT_EQ(decoded.altitude_m, 1523.875);
+  EXPECT_EQ(decoded.altitude_rel_m, -3.125);
+}
+
+// attitude_t: the quaternion (w first) and the three Euler angles survive encode/decode.
+TEST(LcmTypesRoundTrip, Attitude) {
+  nadir::attitude_t msg{};
+  msg.utime = INT64_C(1'700'000'000'000'007);
+  msg.orientation[0] = 0.7071067811865476;
+  msg.orientation[1] = -0.01;
+  msg.orientation[2] = 0.02;
+  msg.orientation[3] = 0.7070360705084289;
+  msg.roll_rad = -0.031;
+  msg.pitch_rad = 0.0125;
+  msg.yaw_rad = 1.5707963267948966;
+
+  const nadir::attitude_t decoded = RoundTrip(msg);
+  EXPECT_EQ(decoded.utime, INT64_C(1'700'000'000'000'007));
+  ExpectArrayEq(decoded.orientation, {0.7071067811865476, -0.01, 0.02, 0.7070360705084289});
+  EXPECT_EQ(decoded.roll_rad, -0.031);
+  EXPECT_EQ(decoded.pitch_rad, 0.0125);
+  EXPECT_EQ(decoded.yaw_rad, 1.5707963267948966);
+}
+
+// velocity_t: every field survives encode/decode.
+TEST(LcmTypesRoundTrip, Velocity) {
+  nadir::velocity_t msg{};
+  msg.utime = INT64_C(1'700'000'000'000'009);
+  msg.velocity_ned_mps[0] = 21.5;
+  msg.velocity_ned_mps[1] = -3.75;
+  msg.velocity_ned_mps[2] = 0.1;
+
+  const nadir::velocity_t decoded = RoundTrip(msg);
+  EXPECT_EQ(decoded.utime, INT64_C(1'700'000'000'000'009));
+  ExpectArrayEq(decoded.velocity_ned_mps, {21.5, -3.75, 0.1});
+}
+
+// body_rates_t: every field survives encode/decode.
+TEST(LcmTypesRoundTrip, BodyRates) {
+  nadir::body_rates_t msg{};
+  msg.utime = INT64_C(1'700'000'000'000'011);
+  msg.angular_velocity_dps[0] = 45.0;
+  msg.angular_velocity_dps[1] = -1.5;
+  msg.angular_velocity_dps[2] = 28.64788975654116;
+
+  const nadir::body_rates_t decoded = RoundTrip(msg);
+  EXPECT_EQ(decoded.utime, INT64_C(1'700'000'000'000'011));
+  ExpectArrayEq(decoded.angular_velocity_dps, {45.0, -1.5, 28.64788975654116});
 }
 
 // --- Malformed input ------------------------------------------------------------------------

@@ -97,18 +97,56 @@ TEST(FixedWing, SameSeedSameFlight) {
   EXPECT_NE(a.state().p_ned_m, c.state().p_ned_m);
 }
 
-// Waypoints closer than two turn radii are refused, naming the waypoint; bad speeds too.
+// A leg shorter than the turns at its ends need is refused, naming the waypoint; a short
+// straight leg is flyable; bad speeds are refused.
 TEST(FixedWing, UnreachableWaypointsAndBadParamsAreRefused) {
-  FixedWingParams params;  // 20 m/s, 45 deg: turn radius 40.8 m
+  FixedWingParams params;  // 20 m/s, 45 deg: turn radius 40.8 m, 90 deg turns lead by 40.8 m
   try {
+    // 60 m between two 90 deg turns, which need 81.6 m.
     FixedWing(params, {0, 0, -100}, 0.0,
-              {Eigen::Vector3d(500, 0, -100), Eigen::Vector3d(530, 0, -100)});
+              {Eigen::Vector3d(500, 0, -100), Eigen::Vector3d(500, 60, -100),
+               Eigen::Vector3d(0, 60, -100)});
     FAIL() << "no error";
   } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("waypoint 2"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("waypoint 2 is 60"), std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("need 81.6"), std::string::npos) << error.what();
   }
+  // 90 m between the same turns is enough, and so is 30 m on a straight line.
+  EXPECT_NO_THROW(FixedWing(params, {0, 0, -100}, 0.0,
+                            {Eigen::Vector3d(500, 0, -100), Eigen::Vector3d(500, 90, -100),
+                             Eigen::Vector3d(0, 90, -100)}));
+  EXPECT_NO_THROW(FixedWing(params, {0, 0, -100}, 0.0,
+                            {Eigen::Vector3d(500, 0, -100), Eigen::Vector3d(530, 0, -100)}));
   params.airspeed_mps = -3.0;
   EXPECT_THROW(FixedWing(params, {0, 0, 0}, 0.0, {Eigen::Vector3d(500, 0, 0)}), core::ParamError);
+}
+
+// A leg with its own speed: the airspeed changes towards it at max_acceleration_mps2 and
+// no faster, and the next leg's 0 returns to the cruise airspeed.
+TEST(FixedWing, LegSpeedsChangeAirspeedAtTheAccelerationLimit) {
+  FixedWingParams params;
+  params.airspeed_mps = 25.0;
+  params.max_acceleration_mps2 = 0.5;
+  FixedWing aircraft(params, {0, 0, -100}, 0.0,
+                     std::vector<Waypoint>{{Eigen::Vector3d(600, 0, -100), 15.0},
+                                           {Eigen::Vector3d(1600, 0, -100), 0.0}});
+  EXPECT_DOUBLE_EQ(aircraft.airspeed_mps(), 15.0);  // starts at its first leg's speed
+  double max_change = 0.0, previous = aircraft.airspeed_mps();
+  bool reached_cruise = false;
+  while (!aircraft.finished()) {
+    aircraft.step();
+    max_change = std::max(max_change, std::abs(aircraft.airspeed_mps() - previous));
+    previous = aircraft.airspeed_mps();
+    if (aircraft.nextWaypoint() == 0) {
+      EXPECT_DOUBLE_EQ(aircraft.airspeed_mps(), 15.0);
+    }
+    reached_cruise = reached_cruise || aircraft.airspeed_mps() == 25.0;
+  }
+  EXPECT_TRUE(reached_cruise);
+  EXPECT_LE(max_change, 0.5 * params.step_s + 1e-12);
+  // Level flight along north: the ground speed is the airspeed.
+  EXPECT_NEAR(aircraft.state().v_ned_mps.norm(), 25.0, 1e-9);
 }
 
 // Seed 000's rectangle: 50 m x 25 m flown four times is 600 m, and the multirotor

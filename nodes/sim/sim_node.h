@@ -1,0 +1,44 @@
+#pragma once
+// The simulator's wiring to a bus, shared by nadir-sim and the batch runner:
+// loading a recorded flight, and publishing each step's truth and sensor
+// samples as messages on the scenario's channels.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "core/bus.h"
+#include "core/geodesy.h"
+#include "nodes/sim/sim_params.h"
+#include "nodes/sim/simulator.h"
+#include "nodes/sim/trajectory.h"
+
+namespace nadir::sim {
+
+// The recorded flight of params.path, or nothing if the path is empty. The
+// format is taken from the extension with "auto" (.tum or .txt: TUM, .csv:
+// flight CSV, anything else: LCM log). Throws TrajectoryError naming the file.
+// A damaged LCM log is used up to the damage and *warning says so.
+std::optional<Trajectory> loadFlight(const FlightParams& params, const core::LocalNedFrame& frame,
+                                     std::string* warning = nullptr);
+
+class SimPublisher {
+ public:
+  SimPublisher(core::Bus& bus, const SimParams& params, const Simulator& simulator);
+  // Publishes the truth pose and whatever else fell due in this step.
+  void publish(const SimOutput& output);
+  // Messages published per channel.
+  const std::map<std::string, std::int64_t>& counts() const { return counts_; }
+
+ private:
+  template <class Msg>
+  void send(const std::string& channel, const Msg& message);
+
+  core::Bus& bus_;
+  SimParams params_;
+  const Simulator& simulator_;
+  std::map<std::string, std::int64_t> counts_;
+};
+
+}  // namespace nadir::sim

@@ -1,0 +1,90 @@
+#include "nodes/sim/sim_params.h"
+
+namespace nadir::sim {
+
+void VehicleParams::visit(core::ParamVisitor& v) {
+  v.field(
+      "kind", &kind,
+      {.doc = "fixed_wing, multirotor or rover", .choices = {"fixed_wing", "multirotor", "rover"}});
+  v.field("altitude_agl_m", &altitude_agl_m,
+          {.doc = "mission altitude above the start's ground, m", .min = 0, .max = 20000});
+  fixed_wing.visit(v);
+  core::visitGroup(v, "multirotor", "multirotor (kind: multirotor)", multirotor);
+  core::visitGroup(v, "rover", "ground rover (kind: rover)", rover);
+}
+
+void StartParams::visit(core::ParamVisitor& v) {
+  v.field("north_m", &north_m, {.doc = "start, world frame north, m", .min = -1e6, .max = 1e6});
+  v.field("east_m", &east_m, {.doc = "start, world frame east, m", .min = -1e6, .max = 1e6});
+  v.field("height_agl_m", &height_agl_m,
+          {.doc = "start height above the ground, m", .min = 0, .max = 20000});
+  v.field("at_mission_altitude", &at_mission_altitude,
+          {.doc = "start at vehicle.altitude_agl_m (ignores height_agl_m)"});
+  v.field("heading_deg", &heading_deg,
+          {.doc = "initial heading from north, deg", .min = -360, .max = 360});
+  v.field("face_first_waypoint", &face_first_waypoint,
+          {.doc = "start heading towards the first waypoint (ignores heading_deg)"});
+}
+
+void RouteParams::visit(core::ParamVisitor& v) {
+  v.field("frame", &frame,
+          {.doc = "waypoints as start ([n, e] from the start), ned ([n, e]) or geodetic "
+                  "([lat, lon] deg); optional third value: height, m",
+           .choices = {"start", "ned", "geodetic"}});
+  v.field("waypoints", &waypoints,
+          {.doc = "waypoints, [a, b] or [a, b, height_m]",
+           .min = -1e7,
+           .max = 1e7,
+           .row_sizes = {2, 3}});
+  v.field(
+      "leg_speeds_mps", &leg_speeds_mps,
+      {.doc = "speed on the leg to each waypoint, m/s; 0 or [] = cruise", .min = 0, .max = 300});
+  v.field("repeat", &repeat, {.doc = "fly the waypoints this many times", .min = 1, .max = 1000});
+  v.field("follow_terrain", &follow_terrain,
+          {.doc = "heights above each waypoint's ground instead of the start's"});
+}
+
+void FlightParams::visit(core::ParamVisitor& v) {
+  v.field("path", &path, {.doc = "recorded flight to replay as truth; empty: fly the route"});
+  v.field("format", &format,
+          {.doc = "auto, tum, csv or lcm", .choices = {"auto", "tum", "csv", "lcm"}});
+  v.field("pose_channel", &pose_channel, {.doc = "LCM log: pose_t channel"});
+  v.field("position_channel", &position_channel,
+          {.doc = "LCM log without poses: geodetic_position_t channel"});
+  v.field("attitude_channel", &attitude_channel,
+          {.doc = "LCM log without poses: attitude_t channel"});
+}
+
+void TruthParams::visit(core::ParamVisitor& v) {
+  v.field("rate_hz", &rate_hz,
+          {.doc = "simulation step and truth pose rate, Hz", .min = 200, .max = 5000});
+  v.field("channel", &channel, {.doc = "truth pose_t channel"});
+  v.field("nav_rate_hz", &nav_rate_hz,
+          {.doc = "rate of the NAV_* channels, Hz; 0 = off", .min = 0, .max = 5000});
+  v.field("nav_position_channel", &nav_position_channel,
+          {.doc = "geodetic_position_t: lat/lon rad, altitude above the start"});
+  v.field("nav_attitude_channel", &nav_attitude_channel, {.doc = "attitude_t in NED"});
+  v.field("nav_velocity_channel", &nav_velocity_channel, {.doc = "velocity_t in NED"});
+  v.field("nav_rates_channel", &nav_rates_channel, {.doc = "body_rates_t, deg/s FRD"});
+}
+
+void SensorsParams::visit(core::ParamVisitor& v) {
+  core::visitGroup(v, "imu", "gyro and accelerometer", imu);
+  core::visitGroup(v, "rangefinder", "distance along a body ray to the terrain", rangefinder);
+  core::visitGroup(v, "gps", "GNSS fixes", gps);
+  core::visitGroup(v, "barometer", "barometric altitude", barometer);
+}
+
+void SimParams::visit(core::ParamVisitor& v) {
+  v.field(
+      "duration_s", &duration_s,
+      {.doc = "stop after this much sim time, s; 0 = when the route ends", .min = 0, .max = 1e6});
+  core::visitGroup(v, "vehicle", "the simulated vehicle", vehicle);
+  core::visitGroup(v, "start", "where the vehicle starts", start);
+  core::visitGroup(v, "route", "the waypoints it follows", route);
+  core::visitGroup(v, "flight", "a recorded flight replayed as truth", flight);
+  core::visitGroup(v, "truth", "the truth stream", truth);
+  core::visitGroup(v, "sensors", "sensor models", sensors);
+}
+
+}  // namespace nadir::sim

@@ -1,0 +1,179 @@
+#include "nodes/sim/simulator.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "core/clock.h"
+
+namespace nadir::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+}  // namespace
+
+ResolvedRoute resolveRoute(const SimParams& params, const terrain::World& world,
+                           const core::LocalNedFrame& frame) {
+  const RouteParams& route = params.route;
+  if (route.waypoints.empty()) {
+    throw core::ParamError("route.waypoints: no waypoints to fly (and no flight.path to replay)");
+  }
+  if (!route.leg_speeds_mps.empty() && route.leg_speeds_mps.size() != route.waypoints.size()) {
+    throw core::ParamError("route.leg_speeds_mps: " + std::to_string(route.leg_speeds_mps.size()) +
+                           " speeds for " + std::to_string(route.waypoints.size()) +
+                           " waypoints (give one per waypoint, or none)");
+  }
+  ResolvedRoute resolved;
+  const double start_ground_m = world.groundUp_m(params.start.north_m, params.start.east_m);
+  const double start_height_m =
+      params.start.at_mission_altitude ? params.vehicle.altitude_agl_m : params.start.height_agl_m;
+  resolved.start_ned_m = {params.start.north_m, params.start.east_m,
+                          -(start_ground_m + start_height_m)};
+  std::vector<Waypoint> once;
+  for (std::size_t i = 0; i < route.waypoints.size(); ++i) {
+    const std::vector<double>& row = route.waypoints[i];
+    Eigen::Vector2d ne;
+    if (route.frame == "start") {
+      ne = {params.start.north_m + row[0], params.start.east_m + row[1]};
+    } else if (route.frame == "ned") {
+      ne = {row[0], row[1]};
+    } else {
+      if (std::abs(row[0]) > 90.0) {
+        throw core::ParamError("route.waypoints[" + std::to_string(i) + "]: latitude " +
+                               std::to_string(row[0]) + " deg is outside [-90, 90]");
+      }
+      const Eigen::Vector3d p =
+          frame.nedFromGeodetic(core::geodeticFromDegrees(row[0], row[1], frame.origin().alt_m));
+      ne = {p.x(), p.y()};
+    }
+    const double height_m = row.size() == 3 ? row[2] : params.vehicle.altitude_agl_m;
+    const double ground_m =
+        route.follow_terrain ? world.groundUp_m(ne.x(), ne.y()) : start_ground_m;
+    const double speed_mps = route.leg_speeds_mps.empty() ? 0.0 : route.leg_speeds_mps[i];
+    once.push_back({Eigen::Vector3d(ne.x(), ne.y(), -(ground_m + height_m)), speed_mps});
+  }
+  for (int lap = 0; lap < route.repeat; ++lap) {
+    resolved.waypoints.insert(resolved.waypoints.end(), once.begin(), once.end());
+  }
+  resolved.start_heading_rad = params.start.heading_deg * kDeg;
+  const Eigen::Vector3d to_first = resolved.waypoints.front().p_ned_m - resolved.start_ned_m;
+  if (params.start.face_first_waypoint && to_first.head<2>().norm() > 1e-6) {
+    resolved.start_heading_rad = std::atan2(to_first.y(), to_first.x());
+  }
+  return resolved;
+}
+
+Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::World> world,
+                     const core::LocalNedFrame& frame, std::optional<Trajectory> flight)
+    : params_(params), world_(std::move(world)), frame_(frame), flight_(std::move(flight)) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "simulation");
+  const double step_s = 1.0 / params_.truth.rate_hz;
+  step_us_ = std::max<std::int64_t>(1, core::utimeFromSeconds(step_s));
+  if (flight_) {
+    start_utime_ = flight_->startUtime();
+  } else {
+    route_ = resolveRoute(params_, *world_, frame_);
+    const VehicleParams& vehicle = params_.vehicle;
+    try {
+      if (vehicle.kind == "fixed_wing") {
+        FixedWingParams p = vehicle.fixed_wing;
+        p.step_s = step_s;
+        vehicle_.emplace<FixedWing>(p, route_.start_ned_m, route_.start_heading_rad,
+                                    route_.waypoints);
+      } else if (vehicle.kind == "multirotor") {
+        MultirotorParams p = vehicle.multirotor;
+        p.step_s = step_s;
+        vehicle_.emplace<Multirotor>(p, route_.start_ned_m, route_.start_heading_rad,
+                                     route_.waypoints);
+      } else {
+        RoverParams p = vehicle.rover;
+        p.step_s = step_s;
+        vehicle_.emplace<Rover>(p, route_.start_ned_m, route_.start_heading_rad, route_.waypoints);
+      }
+    } catch (const std::invalid_argument& error) {
+      throw core::ParamError("route.waypoints: " + std::string(error.what()));
+    }
+  }
+  utime_ = start_utime_;
+  start_altitude_m_ = frame_.geodeticFromNed(currentState().p_ned_m).alt_m;
+
+  const SensorsParams& sensors = params_.sensors;
+  if (sensors.imu.enabled) imu_.emplace(sensors.imu.model);
+  if (sensors.rangefinder.enabled) rangefinder_.emplace(sensors.rangefinder.model);
+  if (sensors.gps.enabled) gps_.emplace(sensors.gps.model);
+  if (sensors.barometer.enabled) barometer_.emplace(sensors.barometer.model);
+}
+
+VehicleState Simulator::currentState() const {
+  if (flight_) return flight_->at(utime_);
+  return std::visit(
+      [this](const auto& vehicle) -> VehicleState {
+        if constexpr (std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {
+          return {};
+        } else {
+          VehicleState state = vehicle.state();
+          state.utime += start_utime_;
+          return state;
+        }
+      },
+      vehicle_);
+}
+
+bool Simulator::vehicleFinished() const {
+  if (flight_) return utime_ >= flight_->endUtime();
+  return std::visit(
+      [](const auto& vehicle) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {
+          return true;
+        } else {
+          return vehicle.finished();
+        }
+      },
+      vehicle_);
+}
+
+bool Simulator::finished() const {
+  if (!started_) return false;
+  if (params_.duration_s > 0.0 &&
+      utime_ - start_utime_ >= core::utimeFromSeconds(params_.duration_s)) {
+    return true;
+  }
+  return vehicleFinished();
+}
+
+SimOutput Simulator::step() {
+  if (started_) {
+    utime_ += step_us_;
+    std::visit(
+        [](auto& vehicle) {
+          if constexpr (!std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {
+            vehicle.step();
+          }
+        },
+        vehicle_);
+  }
+  started_ = true;
+  SimOutput out;
+  out.truth = currentState();
+  out.truth.utime = utime_;
+  const std::int64_t t = utime_;
+  if (imu_ && core::due(t, params_.sensors.imu.model.rate_hz, imu_due_)) {
+    out.imu = imu_->sample(out.truth);
+  }
+  if (rangefinder_ && core::due(t, params_.sensors.rangefinder.model.rate_hz, range_due_)) {
+    out.range = rangefinder_->sample(out.truth, *world_);
+  }
+  if (gps_ && core::due(t, params_.sensors.gps.model.rate_hz, gps_due_)) {
+    out.gps = gps_->sample(out.truth, frame_);
+  }
+  if (barometer_ && core::due(t, params_.sensors.barometer.model.rate_hz, baro_due_)) {
+    out.baro = barometer_->sample(out.truth, frame_);
+  }
+  out.nav_due =
+      params_.truth.nav_rate_hz > 0.0 && core::due(t, params_.truth.nav_rate_hz, nav_due_);
+  return out;
+}
+
+}  // namespace nadir::sim

@@ -1,0 +1,95 @@
+#pragma once
+// The simulator: a vehicle flying its route (or a recorded flight replayed)
+// stepped at the truth rate in sim time, with its sensors sampled on their
+// own fixed grids. Plain structs out; the node or the batch runner turns them
+// into messages. Deterministic: the same params and seeds give the same outputs.
+
+#include <memory>
+#include <optional>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/geodesy.h"
+#include "nodes/sim/sensors.h"
+#include "nodes/sim/sim_params.h"
+#include "nodes/sim/trajectory.h"
+#include "nodes/sim/vehicles.h"
+#include "terrain/world.h"
+
+namespace nadir::sim {
+
+// The route in the world frame: start, initial heading, waypoints with
+// repeat applied and heights resolved against the terrain.
+struct ResolvedRoute {
+  Eigen::Vector3d start_ned_m = Eigen::Vector3d::Zero();
+  double start_heading_rad = 0.0;
+  std::vector<Waypoint> waypoints;
+};
+
+// Throws core::ParamError naming the key for an empty route or a speed list
+// whose length does not match the waypoints.
+ResolvedRoute resolveRoute(const SimParams& params, const terrain::World& world,
+                           const core::LocalNedFrame& frame);
+
+// One simulation step: the true state and the sensor samples that fell due.
+struct SimOutput {
+  VehicleState truth;
+  std::optional<ImuSample> imu;
+  std::optional<RangeSample> range;
+  std::optional<GpsSample> gps;
+  std::optional<BaroSample> baro;
+  // The NAV_* channels are due (at truth.nav_rate_hz).
+  bool nav_due = false;
+};
+
+class Simulator {
+ public:
+  // With a flight, it is the truth from its first to its last pose (the vehicle
+  // and route are not used); else the vehicle of params.vehicle.kind flies the
+  // route. Throws core::ParamError for parameters that cannot be flown (an
+  // unreachable waypoint among them), naming the key.
+  Simulator(const SimParams& params, std::shared_ptr<const terrain::World> world,
+            const core::LocalNedFrame& frame, std::optional<Trajectory> flight = std::nullopt);
+
+  // The first call gives the initial state; each later call advances one step
+  // of 1 / truth.rate_hz.
+  SimOutput step();
+  // True once the route or the flight has ended or duration_s has passed.
+  bool finished() const;
+
+  std::int64_t startUtime() const { return start_utime_; }
+  // Ellipsoid altitude of the start, m: the zero of the NAV relative altitude.
+  double startAltitude_m() const { return start_altitude_m_; }
+  const ResolvedRoute& route() const { return route_; }
+  const core::LocalNedFrame& frame() const { return frame_; }
+
+ private:
+  VehicleState currentState() const;
+  bool vehicleFinished() const;
+
+  SimParams params_;
+  std::shared_ptr<const terrain::World> world_;
+  core::LocalNedFrame frame_;
+  std::optional<Trajectory> flight_;
+  ResolvedRoute route_;
+  std::variant<std::monostate, FixedWing, Multirotor, Rover> vehicle_;
+  std::int64_t step_us_ = 0;
+  std::int64_t start_utime_ = 0;
+  std::int64_t utime_ = 0;
+  bool started_ = false;
+  double start_altitude_m_ = 0.0;
+
+  std::optional<ImuModel> imu_;
+  std::optional<RangefinderModel> rangefinder_;
+  std::optional<GpsModel> gps_;
+  std::optional<BarometerModel> barometer_;
+  std::int64_t imu_due_ = core::kDueAtFirstCall;
+  std::int64_t range_due_ = core::kDueAtFirstCall;
+  std::int64_t gps_due_ = core::kDueAtFirstCall;
+  std::int64_t baro_due_ = core::kDueAtFirstCall;
+  std::int64_t nav_due_ = core::kDueAtFirstCall;
+};
+
+}  // namespace nadir::sim
