@@ -1,11 +1,15 @@
 #include "cli/demo.h"
 
+#include <CLI/CLI.hpp>
+#include <memory>
+
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <numbers>
 
+#include "cli/commands.h"
 #include "cli/doctor.h"
 #include "core/bus.h"
 #include "core/clock.h"
@@ -140,6 +144,15 @@ int runDemo(const std::string& out_dir) {
   const bool round_trip_ok = replayed == published && max_error_m == 0.0 && frames > 0;
   std::cout << (round_trip_ok ? "demo finished\n" : "demo FAILED: the log did not round-trip\n");
   return round_trip_ok ? 0 : 1;
+}
+
+void addDemoCommand(CLI::App& app) {
+  auto out_dir = std::make_shared<std::string>("out/demo");
+  auto* demo = app.add_subcommand("demo", "Run what nadir has so far and say what ran");
+  demo->add_option("--out", *out_dir, "Output folder")->capture_default_str();
+  demo->callback([out_dir] {
+    if (const int status = runDemo(*out_dir); status != 0) throw CLI::RuntimeError(status);
+  });
 }
 
 }  // namespace nadir::cli

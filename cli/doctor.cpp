@@ -1,5 +1,9 @@
 #include "cli/doctor.h"
 
+#include "cli/commands.h"
+
+#include <CLI/CLI.hpp>
+
 #include <lcm/lcm.h>
 
 #include <GeographicLib/Config.h>
@@ -186,6 +190,14 @@ int runDoctor() {
                     ? "all checks passed\n"
                     : std::to_string(failures) + " check(s) failed: run the fix lines above\n");
   return failures == 0 ? 0 : 1;
+}
+
+void addDoctorCommand(CLI::App& app) {
+  app.add_subcommand("doctor",
+                     "Check multicast, UDP buffers and headless OpenGL; print the fix for each")
+      ->callback([] {
+        if (const int status = runDoctor(); status != 0) throw CLI::RuntimeError(status);
+      });
 }
 
 }  // namespace nadir::cli

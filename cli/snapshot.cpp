@@ -1,5 +1,10 @@
 #include "cli/snapshot.h"
 
+#include "cli/commands.h"
+
+#include <CLI/CLI.hpp>
+#include <memory>
+
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -83,6 +88,25 @@ int runSnapshot(const std::string& config_path, const std::vector<std::string>& 
             << " m above ground (" << frame.stats.tiles << " tiles, " << frame.stats.triangles
             << " triangles)\n";
   return 0;
+}
+
+void addSnapshotCommand(CLI::App& app) {
+  struct Options {
+    std::string config;
+    std::string out = "snapshot.png";
+    std::vector<std::string> overrides;
+  };
+  auto options = std::make_shared<Options>();
+  auto* snapshot = app.add_subcommand(
+      "snapshot", "Render what a downward camera sees from one pose over a world, as a PNG");
+  snapshot->add_option("--config", options->config, "YAML parameter file")
+      ->check(CLI::ExistingFile);
+  snapshot->add_option("--set", options->overrides, "override a parameter: key=value (repeatable)");
+  snapshot->add_option("--out", options->out, "PNG to write")->capture_default_str();
+  snapshot->callback([options] {
+    const int status = runSnapshot(options->config, options->overrides, options->out);
+    if (status != 0) throw CLI::RuntimeError(status);
+  });
 }
 
 }  // namespace nadir::cli

@@ -14,6 +14,7 @@ pkg_check_modules(OPENGL REQUIRED IMPORTED_TARGET opengl)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(CLI11 REQUIRED)
 find_package(Threads REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
 
 # Found here only to report their versions in `nadir doctor`; later libraries link them.
 find_package(OpenCV 4 QUIET COMPONENTS core)
