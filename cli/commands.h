@@ -9,10 +9,27 @@ namespace CLI {
 class App;
 }
 
+namespace nadir::run {
+struct RunResult;
+struct RunProgress;
+}  // namespace nadir::run
+
 namespace nadir::cli {
 
 void addDoctorCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addSnapshotCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
+void addRunCommand(CLI::App& app);
+void addLaunchCommand(CLI::App& app);
+void addSweepCommand(CLI::App& app);
+void addLogCommands(CLI::App& app);
+void addEvalCommand(CLI::App& app);
+
+// nadir run's and nadir demo's progress line, on stderr, and its end.
+void printRunProgress(const run::RunProgress& progress);
+void endRunProgress();
+// The results table and the files a run wrote.
+void printRunResult(const run::RunResult& result);
 
 }  // namespace nadir::cli

@@ -12,6 +12,12 @@ int main(int argc, char** argv) {
   nadir::cli::addDoctorCommand(app);
   nadir::cli::addDemoCommand(app);
   nadir::cli::addSnapshotCommand(app);
+  nadir::cli::addExportCommand(app);
+  nadir::cli::addRunCommand(app);
+  nadir::cli::addLaunchCommand(app);
+  nadir::cli::addSweepCommand(app);
+  nadir::cli::addLogCommands(app);
+  nadir::cli::addEvalCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

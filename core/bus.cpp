@@ -85,6 +85,11 @@ void BusParams::visit(ParamVisitor& v) {
                   "net.core.rmem_default",
            .min = 0,
            .max = 2147483647});
+  v.field("queue_capacity", &queue_capacity,
+          {.doc = "messages a subscription holds while its handler is busy before the oldest "
+                  "is dropped (udpm, memq)",
+           .min = 1,
+           .max = 1000000});
 }
 
 std::string BusParams::resolvedUrl() const {
@@ -97,13 +102,18 @@ std::string BusParams::resolvedUrl() const {
   return resolved;
 }
 
-std::unique_ptr<Bus> openBus(const BusParams& params) { return openBus(params.resolvedUrl()); }
+std::unique_ptr<Bus> openBus(const BusParams& params) {
+  const std::string resolved = params.resolvedUrl();
+  if (resolved.starts_with("file://")) {
+    return std::make_unique<LogBus>(LogBusOptions::fromUrl(resolved));
+  }
+  return std::make_unique<LcmBus>(resolved, params.queue_capacity);
+}
 
 std::unique_ptr<Bus> openBus(const std::string& url) {
-  const std::string resolved = url.empty() ? defaultBusUrl() : url;
-  if (resolved.starts_with("file://"))
-    return std::make_unique<LogBus>(LogBusOptions::fromUrl(resolved));
-  return std::make_unique<LcmBus>(resolved);
+  BusParams params;
+  params.url = url;
+  return openBus(params);
 }
 
 }  // namespace nadir::core

@@ -117,6 +117,11 @@ class Bus {
 struct BusParams {
   std::string url;
   std::int64_t recv_buf_size_bytes = 0;
+  // LCM (udpm, memq): messages each subscription may hold while its handler
+  // is busy before LCM drops the oldest; LCM's own default is 30, which a
+  // camera loses poses at 400 Hz with while it renders a frame.
+  int queue_capacity = kDefaultQueueCapacity;
+  static constexpr int kDefaultQueueCapacity = 1000;
 
   void visit(ParamVisitor& v);
   // url with defaults applied and, for udpm://, recv_buf_size added when set here.

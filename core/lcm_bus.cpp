@@ -14,13 +14,15 @@ struct LcmBus::Entry {
   lcm_subscription_t* subscription = nullptr;
 };
 
-LcmBus::LcmBus(const std::string& url) : url_(url) {
+LcmBus::LcmBus(const std::string& url, int queue_capacity)
+    : url_(url), queue_capacity_(queue_capacity) {
   lcm_ = lcm_create(url_.c_str());
   if (lcm_ == nullptr) {
     throw BusError("cannot open LCM URL '" + url_ +
                    "' (for udpm://, a multicast route is needed: run `nadir doctor`)");
   }
   counter_ = lcm_subscribe(lcm_, ".*", &LcmBus::onAnyMessage, this);
+  lcm_subscription_set_queue_capacity(counter_, queue_capacity_);
 }
 
 LcmBus::~LcmBus() {
@@ -54,6 +56,7 @@ void LcmBus::addSubscription(const Handler& handler) {
   if (entry->subscription == nullptr) {
     throw BusError("LCM refused the subscription to '" + handler.channel_regex + "'");
   }
+  lcm_subscription_set_queue_capacity(entry->subscription, queue_capacity_);
   entries_.emplace(handler.id, std::move(entry));
 }
 

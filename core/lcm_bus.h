@@ -16,8 +16,9 @@ namespace nadir::core {
 
 class LcmBus final : public Bus {
  public:
-  // Throws BusError naming the URL when LCM cannot open it.
-  explicit LcmBus(const std::string& url);
+  // Throws BusError naming the URL when LCM cannot open it. queue_capacity:
+  // messages each subscription holds while handlers are busy (LCM drops the oldest beyond).
+  explicit LcmBus(const std::string& url, int queue_capacity = BusParams::kDefaultQueueCapacity);
   ~LcmBus() override;
 
   std::string url() const override { return url_; }
@@ -33,6 +34,7 @@ class LcmBus final : public Bus {
   static void onAnyMessage(const lcm_recv_buf_t* rbuf, const char* channel, void* user);
 
   std::string url_;
+  int queue_capacity_;
   lcm_t* lcm_ = nullptr;
   lcm_subscription_t* counter_ = nullptr;
   std::map<int, std::unique_ptr<Entry>> entries_;

@@ -1,5 +1,6 @@
 #include "core/lcm_log.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -72,6 +73,7 @@ std::optional<LogEvent> LcmLogReader::next() {
       continue;
     }
     LogEvent event;
+    event.offset = offset;
     event.event_number = static_cast<std::int64_t>(readBigEndian(header + 4, 8));
     event.timestamp_utime = static_cast<std::int64_t>(readBigEndian(header + 12, 8));
     event.channel.resize(static_cast<std::size_t>(channel_length));
@@ -80,39 +82,123 @@ std::optional<LogEvent> LcmLogReader::next() {
         std::fread(event.data.data(), 1, event.data.size(), file_) != event.data.size()) {
       throw LogError("read error in " + path_ + " at byte " + std::to_string(offset));
     }
+    const std::int64_t end = offset + static_cast<std::int64_t>(kHeaderSize) + body;
+    if (!followedByEvent(end)) {
+      // Damage follows this event, or its lengths are damaged and the next
+      // event starts inside it: then it is skipped up to that event.
+      const std::int64_t inside = findMagic(offset + 1, end);
+      if (inside >= 0) {
+        if (recordDamage(LogDamage::Kind::kSkipped, offset, inside - offset)) {
+          skipped_bytes_ += inside - offset;
+        }
+        std::fseek(file_, inside, SEEK_SET);
+        continue;
+      }
+      std::fseek(file_, end, SEEK_SET);
+    }
     ++events_read_;
     return event;
   }
+}
+
+// True if the bytes at end start an event (or the start of one, at the end
+// of the file), or end is the end of the file. Leaves the position unchanged
+// only when true; callers seek afterwards either way.
+bool LcmLogReader::followedByEvent(std::int64_t end) {
+  if (end >= file_size_) return true;
+  const auto count = static_cast<std::size_t>(std::min<std::int64_t>(4, file_size_ - end));
+  std::uint8_t bytes[4];
+  if (std::fread(bytes, 1, count, file_) != count) return false;
+  std::uint8_t magic[4];
+  writeBigEndian(magic, kEventMagic, 4);
+  const bool ok = std::memcmp(bytes, magic, count) == 0;
+  std::fseek(file_, end, SEEK_SET);
+  return ok;
+}
+
+// Offset of the first event magic starting in [from, limit), or -1.
+std::int64_t LcmLogReader::findMagic(std::int64_t from, std::int64_t limit) {
+  std::fseek(file_, from, SEEK_SET);
+  std::uint32_t window = 0;
+  std::int64_t position = from;
+  int c;
+  while (position - 4 < limit - 1 && (c = std::fgetc(file_)) != EOF) {
+    window = (window << 8) | static_cast<std::uint32_t>(c);
+    ++position;
+    if (position - from >= 4 && window == kEventMagic) return position - 4;
+  }
+  return -1;
 }
 
 // Looks for the next event magic at or after offset. If none, the bytes from the
 // damaged event to the end are a truncated tail.
 bool LcmLogReader::resyncFrom(std::int64_t offset) {
   const std::int64_t damaged_at = offset - 1;
-  std::fseek(file_, offset, SEEK_SET);
-  std::uint32_t window = 0;
-  std::int64_t position = offset;
-  int c;
-  while ((c = std::fgetc(file_)) != EOF) {
-    window = (window << 8) | static_cast<std::uint32_t>(c);
-    ++position;
-    if (position - offset >= 4 && window == kEventMagic) {
-      const std::int64_t event_start = position - 4;
+  const std::int64_t event_start = findMagic(offset, file_size_);
+  if (event_start >= 0) {
+    if (recordDamage(LogDamage::Kind::kSkipped, damaged_at, event_start - damaged_at)) {
       skipped_bytes_ += event_start - damaged_at;
-      std::fseek(file_, event_start, SEEK_SET);
-      return true;
     }
+    std::fseek(file_, event_start, SEEK_SET);
+    return true;
   }
   truncated_tail_bytes_ = file_size_ - damaged_at;
   truncated_at_ = damaged_at;
+  recordDamage(LogDamage::Kind::kTruncated, damaged_at, truncated_tail_bytes_);
+  std::fseek(file_, file_size_, SEEK_SET);
   return false;
+}
+
+// Adds a damaged stretch unless an earlier read already covered it; adjacent
+// skipped stretches merge. Returns false if it was known.
+bool LcmLogReader::recordDamage(LogDamage::Kind kind, std::int64_t offset, std::int64_t bytes) {
+  for (const LogDamage& known : damage_) {
+    if (known.offset <= offset && offset + bytes <= known.offset + known.bytes) return false;
+  }
+  auto at =
+      std::upper_bound(damage_.begin(), damage_.end(), offset,
+                       [](std::int64_t value, const LogDamage& d) { return value < d.offset; });
+  if (kind == LogDamage::Kind::kSkipped && at != damage_.begin()) {
+    LogDamage& before = *(at - 1);
+    if (before.kind == kind && before.offset + before.bytes == offset) {
+      before.bytes += bytes;
+      return true;
+    }
+  }
+  damage_.insert(at, LogDamage{kind, offset, bytes});
+  return true;
+}
+
+std::int64_t LcmLogReader::tell() const { return std::ftell(file_); }
+
+void LcmLogReader::seek(std::int64_t offset) {
+  if (offset < 0 || offset > file_size_) {
+    throw LogError("cannot seek to byte " + std::to_string(offset) + " of " + path_ + " (" +
+                   std::to_string(file_size_) + " bytes)");
+  }
+  std::fseek(file_, offset, SEEK_SET);
 }
 
 std::string LcmLogReader::damageReport() const {
   std::string report;
   if (skipped_bytes_ > 0) {
     report +=
-        path_ + ": skipped " + std::to_string(skipped_bytes_) + " damaged bytes between events";
+        path_ + ": skipped " + std::to_string(skipped_bytes_) + " damaged bytes between events (";
+    constexpr int kListed = 5;
+    int listed = 0;
+    int skipped_stretches = 0;
+    for (const LogDamage& d : damage_) {
+      if (d.kind != LogDamage::Kind::kSkipped) continue;
+      ++skipped_stretches;
+      if (listed == kListed) continue;
+      if (listed > 0) report += ", ";
+      report += std::to_string(d.bytes) + " bytes from byte " + std::to_string(d.offset);
+      ++listed;
+    }
+    if (skipped_stretches > listed) {
+      report += " and " + std::to_string(skipped_stretches - listed) + " more stretches";
+    }
+    report += ")";
   }
   if (truncated_tail_bytes_ > 0) {
     if (!report.empty()) report += "; ";

@@ -25,6 +25,19 @@ struct LogEvent {
   std::int64_t timestamp_utime = 0;
   std::string channel;
   std::vector<std::uint8_t> data;
+  // Byte offset of the event's first header byte in the file (set by the reader).
+  std::int64_t offset = -1;
+};
+
+// One damaged stretch of a log file.
+struct LogDamage {
+  enum class Kind {
+    kSkipped,    // bytes between two whole events that are not an event
+    kTruncated,  // an incomplete event at the end of the file
+  };
+  Kind kind = Kind::kSkipped;
+  std::int64_t offset = 0;  // first damaged byte
+  std::int64_t bytes = 0;
 };
 
 class LcmLogReader {
@@ -36,8 +49,9 @@ class LcmLogReader {
   LcmLogReader& operator=(const LcmLogReader&) = delete;
 
   // The next event, or nothing at the end of the log. A damaged event in the
-  // middle is skipped up to the next event magic and counted; a truncated last
-  // event ends the log and is reported by truncatedTailBytes().
+  // middle is skipped up to the next event magic and counted (so is an event
+  // whose length fields put the next event's start inside it); a truncated
+  // last event ends the log and is reported by truncatedTailBytes().
   std::optional<LogEvent> next();
 
   const std::string& path() const { return path_; }
@@ -46,11 +60,27 @@ class LcmLogReader {
   std::int64_t skippedBytes() const { return skipped_bytes_; }
   // Size of an incomplete event at the end of the file (0 if none).
   std::int64_t truncatedTailBytes() const { return truncated_tail_bytes_; }
-  // Human-readable account of damage found so far; empty if the log was clean.
+  // Human-readable account of damage found so far, with byte offsets; empty if
+  // the log was clean.
   std::string damageReport() const;
+  // The damaged stretches found so far, in file order. Reading a stretch again
+  // after seek() does not count it twice.
+  const std::vector<LogDamage>& damage() const { return damage_; }
+
+  // Size of the file when it was opened, bytes.
+  std::int64_t fileSize() const { return file_size_; }
+  // Byte offset the next read starts from.
+  std::int64_t tell() const;
+  // Continues reading from offset, normally an event's LogEvent::offset (a
+  // position inside an event is resynchronised like damage). Throws LogError
+  // if offset is outside the file.
+  void seek(std::int64_t offset);
 
  private:
   bool resyncFrom(std::int64_t offset);
+  std::int64_t findMagic(std::int64_t from, std::int64_t limit);
+  bool followedByEvent(std::int64_t end);
+  bool recordDamage(LogDamage::Kind kind, std::int64_t offset, std::int64_t bytes);
 
   std::string path_;
   std::FILE* file_ = nullptr;
@@ -59,6 +89,7 @@ class LcmLogReader {
   std::int64_t skipped_bytes_ = 0;
   std::int64_t truncated_tail_bytes_ = 0;
   std::int64_t truncated_at_ = -1;
+  std::vector<LogDamage> damage_;
 };
 
 class LcmLogWriter {

@@ -43,6 +43,18 @@ std::map<std::string, camera::CameraSpec> ScenarioParams::allCameras() const {
   return all;
 }
 
+camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario) {
+  camera::CameraNodeParams params;
+  params.bus = scenario.bus;
+  params.pose_channel = scenario.sim.truth.channel;
+  params.world = scenario.world;
+  params.tiles = scenario.tiles;
+  params.renderer = scenario.renderer;
+  params.cameras = scenario.allCameras();
+  params.targets = scenario.targets;
+  return params;
+}
+
 std::string scenarioDirectory() {
   if (const char* dir = std::getenv("NADIR_SCENARIO_DIR"); dir != nullptr && *dir != '\0') {
     return dir;

@@ -12,6 +12,7 @@
 
 #include "core/bus.h"
 #include "core/params.h"
+#include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
 #include "nodes/sim/sim_params.h"
 #include "render/terrain_renderer.h"
@@ -48,6 +49,10 @@ struct ScenarioParams {
   // The main camera as "down" and the others under their names.
   std::map<std::string, camera::CameraSpec> allCameras() const;
 };
+
+// What the camera node needs from a scenario: its bus, the truth channel,
+// the world, tiles, renderer, cameras and targets.
+camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario);
 
 // The folder of the built-in scenarios: $NADIR_SCENARIO_DIR if set, else the
 // project's scenarios/ folder.

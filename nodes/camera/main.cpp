@@ -9,13 +9,10 @@
 #include <atomic>
 #include <csignal>
 #include <iostream>
-#include <map>
 
 #include "core/bus.h"
-#include "nodes/camera/camera_messages.h"
 #include "nodes/camera/camera_node_params.h"
-#include "nodes/camera/camera_rig.h"
-#include "nodes/camera/ground_scene.h"
+#include "nodes/camera/camera_node.h"
 #include "scenario/scenario.h"
 
 namespace {
@@ -43,15 +40,8 @@ int main(int argc, char** argv) {
   try {
     nadir::camera::CameraNodeParams params;
     if (!scenario_name.empty()) {
-      const nadir::scenario::ScenarioParams scenario =
-          nadir::scenario::loadScenario(scenario_name, overrides);
-      params.bus = scenario.bus;
-      params.pose_channel = scenario.sim.truth.channel;
-      params.world = scenario.world;
-      params.tiles = scenario.tiles;
-      params.renderer = scenario.renderer;
-      params.cameras = scenario.allCameras();
-      params.targets = scenario.targets;
+      params = nadir::scenario::cameraNodeParams(
+          nadir::scenario::loadScenario(scenario_name, overrides));
     } else {
       const auto visit = [&params](nadir::core::ParamVisitor& v) { params.visit(v); };
       if (!config_path.empty()) nadir::core::applyYamlFile(config_path, visit);
@@ -60,47 +50,21 @@ int main(int argc, char** argv) {
     if (params.cameras.empty()) params.cameras["down"] = nadir::camera::CameraSpec{};
     std::cout << "nadir-camera parameters:\n" << nadir::core::formatParamsOf(params) << std::flush;
 
-    nadir::camera::GroundScene scene(params.world, params.tiles, params.renderer, params.targets);
-    std::cout << "world: " << scene.built.description << "\n"
-              << "rendering with " << scene.context.info().gl_renderer << "\n";
-    nadir::camera::CameraRig rig(scene.terrain, params.cameras);
-
     auto bus = nadir::core::openBus(params.bus);
-    std::cout << "bus: " << bus->url() << ", poses from " << params.pose_channel << std::endl;
-    std::map<std::string, std::int64_t> last_info_utime;
-    std::uint64_t bad_poses = 0, frames = 0;
-    auto subscription = nadir::core::subscribe<nadir::pose_t>(
-        *bus, params.pose_channel, [&](const nadir::pose_t& pose) {
-          Eigen::Isometry3d T_world_body;
-          try {
-            T_world_body = nadir::camera::bodyPoseFromMessage(pose);
-          } catch (const std::invalid_argument& error) {
-            if (bad_poses++ == 0) std::cerr << "dropping bad poses: " << error.what() << "\n";
-            return;
-          }
-          for (const nadir::camera::CameraFrame& frame : rig.onPose(pose.utime, T_world_body)) {
-            nadir::core::publish(
-                *bus, frame.spec->channel,
-                nadir::camera::toImageMessage(frame.rendered, frame.spec->jpeg_quality));
-            // camera_info_t with the first frame, then once a second.
-            auto& last = last_info_utime[frame.name];
-            if (last == 0 || pose.utime - last >= 1'000'000 || pose.utime < last) {
-              nadir::core::publish(
-                  *bus, frame.spec->info_channel,
-                  nadir::camera::toCameraInfo(frame.name, *frame.spec, rig.intrinsics(frame.name),
-                                              pose.utime));
-              last = pose.utime;
-            }
-            ++frames;
-          }
-        });
+    nadir::camera::CameraNode node(*bus, params);
+    std::cout << "world: " << node.scene().built.description << "\n"
+              << "rendering with " << node.scene().context.info().gl_renderer << "\n"
+              << "bus: " << bus->url() << ", poses from " << params.pose_channel << std::endl;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     while (!g_stop) bus->handle(std::chrono::milliseconds(100));
     const auto stats = bus->stats();
     const auto pose_stats = stats.find(params.pose_channel);
-    std::cout << "nadir-camera: published " << frames << " frames; dropped " << bad_poses
-              << " bad poses and "
+    if (node.badPoses() > 0) {
+      std::cerr << "nadir-camera: first bad pose: " << node.firstBadPose() << "\n";
+    }
+    std::cout << "nadir-camera: published " << node.framesPublished() << " frames; dropped "
+              << node.badPoses() << " bad poses and "
               << (pose_stats == stats.end() ? 0 : pose_stats->second.decode_errors)
               << " undecodable messages" << std::endl;
   } catch (const std::exception& error) {

@@ -295,6 +295,11 @@ void Multirotor::step() {
   // On arrival the position snaps onto the waypoint and the vehicle is at rest.
   state_.v_ned_mps = speed_mps_ == 0.0 ? Eigen::Vector3d::Zero() : velocity;
   state_.a_ned_mps2 = (state_.v_ned_mps - previous_velocity) / dt;
+  // Stopping on a waypoint drops the last few mm/s within one step; the
+  // vehicle brakes at its acceleration limit, so the step's mean acceleration
+  // (and the tilt it causes) is capped there rather than spiking.
+  const double a_norm = state_.a_ned_mps2.norm();
+  if (a_norm > params_.acceleration_mps2) state_.a_ned_mps2 *= params_.acceleration_mps2 / a_norm;
   // Tilt: the thrust must supply the horizontal acceleration, seen in the heading frame.
   const Eigen::Vector3d& a = state_.a_ned_mps2;
   const double forward = std::cos(yaw_rad_) * a.x() + std::sin(yaw_rad_) * a.y();

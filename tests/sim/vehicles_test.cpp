@@ -189,6 +189,23 @@ TEST(Multirotor, TiltsWithAcceleration) {
   EXPECT_NEAR(rpy.roll_rad, 0.0, 1e-9);
 }
 
+// Through stops and starts at every corner the tilt never exceeds atan(a_max / g): the
+// stop on a waypoint does not spike the acceleration.
+TEST(Multirotor, TiltStaysWithinTheAccelerationLimit) {
+  MultirotorParams params;  // 3 m/s, 1.5 m/s^2: at most atan(1.5 / g) = 8.70 deg
+  Multirotor drone(params, {0, 0, -5}, 0.0,
+                   {Eigen::Vector3d(50, 0, -5), Eigen::Vector3d(50, 25, -5),
+                    Eigen::Vector3d(0, 25, -5), Eigen::Vector3d(0, 0, -5)});
+  double max_tilt = 0.0;
+  while (!drone.finished()) {
+    drone.step();
+    const Eigen::Vector3d body_down = drone.state().q_world_body * Eigen::Vector3d::UnitZ();
+    max_tilt = std::max(max_tilt, std::acos(std::clamp(body_down.z(), -1.0, 1.0)));
+  }
+  EXPECT_LE(max_tilt, std::atan(1.5 / 9.80665) + 1e-9);
+  EXPECT_GT(max_tilt, std::atan(1.5 / 9.80665) - 1e-3);  // braking does reach the limit
+}
+
 // The rover's turn at full steering has radius wheelbase / tan(steer): 0.3 m at
 // 30 deg -> 0.520 m; it never steers past its limits; it reaches a slalom's gates.
 TEST(Rover, BicycleTurnRadiusAndSteeringLimits) {

@@ -1,0 +1,124 @@
+// nadir eval: the metrics of a recorded run (from its LCM log), or evo-style APE
+// and RPE between two TUM files. Definitions: eval/run_metrics.h, docs/evaluation.md.
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "cli/commands.h"
+#include "eval/metrics.h"
+#include "eval/run_metrics.h"
+#include "eval/trajectory.h"
+
+namespace nadir::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct EvalCommandOptions {
+  std::string path;  // RUN_DIR or LOG
+  std::string ref;
+  std::string est;
+  eval::EvalOptions eval;
+};
+
+void evaluateRun(const EvalCommandOptions& options) {
+  fs::path log = options.path;
+  if (fs::is_directory(log)) log /= "run.lcmlog";
+  if (!fs::exists(log)) throw eval::EvalError(log.string() + ": no such file or directory");
+  const fs::path dir = log.has_parent_path() ? log.parent_path() : fs::path(".");
+
+  const eval::LogTrajectories recorded = eval::readRunLog(log.string());
+  if (!recorded.damage.empty()) {
+    std::cerr << "nadir eval: warning: " << log.string() << ": " << recorded.damage << "\n";
+  }
+  const eval::RunMetrics metrics = eval::evaluate(recorded.truth, recorded.sources, options.eval);
+
+  std::vector<std::string> written;
+  const std::string metrics_path = (dir / "metrics.json").string();
+  eval::writeMetricsJson(metrics_path, metrics, options.eval);
+  written.push_back(metrics_path);
+  const std::string truth_path = (dir / "truth.tum").string();
+  eval::writeTum(truth_path, recorded.truth);
+  written.push_back(truth_path);
+  for (const auto& [name, estimates] : recorded.sources) {
+    const eval::PoseTrajectory tracked = eval::trackingTrajectory(estimates);
+    if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
+    const std::string path = (dir / (name + ".tum")).string();
+    eval::writeTum(path, tracked);
+    written.push_back(path);
+  }
+
+  std::cout << eval::formatResultsTable(metrics) << "\n";
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    std::cout << (i == 0 ? "wrote " : "      ") << written[i] << "\n";
+  }
+}
+
+void evaluateTumPair(const EvalCommandOptions& options) {
+  const eval::PoseTrajectory ref = eval::readTum(options.ref);
+  const eval::PoseTrajectory est = eval::readTum(options.est);
+  eval::TrajectoryEvaluation evaluation;
+  try {
+    evaluation = eval::evaluateTrajectories(ref, est, options.eval);
+  } catch (const eval::EvalError& error) {
+    throw eval::EvalError(options.est + " against " + options.ref + ": " + error.what());
+  }
+  std::cout << "reference " << options.ref << "\nestimate  " << options.est << "\n"
+            << eval::formatTrajectoryReport(evaluation, options.eval);
+}
+
+}  // namespace
+
+void addEvalCommand(CLI::App& app) {
+  auto options = std::make_shared<EvalCommandOptions>();
+  auto* command = app.add_subcommand(
+      "eval",
+      "Evaluate a run (RUN_DIR or its LOG: metrics.json, TUM files and a results table), or "
+      "compare two TUM trajectories (--ref, --est) with evo's APE and RPE");
+  command->add_option("path", options->path, "run folder (holding run.lcmlog) or LCM log");
+  command->add_option("--ref", options->ref, "reference TUM trajectory (with --est)");
+  command->add_option("--est", options->est, "estimated TUM trajectory (with --ref)");
+  command
+      ->add_option("--align", options->eval.align,
+                   "align the estimate before APE and RPE: none, se3 or sim3 (Umeyama)")
+      ->check(CLI::IsMember({"none", "se3", "sim3"}))
+      ->capture_default_str();
+  command->add_option("--delta", options->eval.rpe_delta, "RPE pair spacing")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--delta-unit", options->eval.rpe_delta_unit,
+                   "unit of --delta: frames or meters")
+      ->check(CLI::IsMember({"frames", "meters"}))
+      ->capture_default_str();
+  command
+      ->add_option("--t-max-diff", options->eval.t_max_diff_s,
+                   "TUM association: largest stamp difference of a pose pair, s")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->callback([options] {
+    const bool pair = !options->ref.empty() || !options->est.empty();
+    if (pair && !options->path.empty()) {
+      throw eval::EvalError("give either RUN_DIR|LOG or --ref and --est, not both");
+    }
+    if (pair && (options->ref.empty() || options->est.empty())) {
+      throw eval::EvalError(options->ref.empty() ? "--est needs --ref REF.tum"
+                                                 : "--ref needs --est EST.tum");
+    }
+    if (!pair && options->path.empty()) {
+      throw eval::EvalError(
+          "nothing to evaluate: give RUN_DIR|LOG, or --ref REF.tum --est EST.tum");
+    }
+    eval::validateOptions(options->eval);
+    if (pair) {
+      evaluateTumPair(*options);
+    } else {
+      evaluateRun(*options);
+    }
+  });
+}
+
+}  // namespace nadir::cli

@@ -1,0 +1,44 @@
+// nadir launch: the scenario's nodes as live processes on UDP LCM (run/launch.h).
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "run/launch.h"
+
+namespace nadir::cli {
+namespace {
+
+std::atomic<bool> g_stop_launch{false};
+
+void onLaunchSignal(int) { g_stop_launch = true; }
+
+}  // namespace
+
+void addLaunchCommand(CLI::App& app) {
+  auto options = std::make_shared<run::LaunchOptions>();
+  auto* command = app.add_subcommand(
+      "launch",
+      "Start the scenario's nodes as live processes on UDP LCM with lcm-logger; print "
+      "their health; stop them all at the end or on Ctrl-C");
+  command->add_option("scenario", options->scenario, "built-in scenario name or YAML file")
+      ->capture_default_str();
+  command->add_option("--out", options->out_dir,
+                      "folder for the node logs and the recording (default out/<scenario>-live)");
+  command->add_option("--set", options->overrides, "override a parameter: key=value (repeatable)");
+  command->add_flag("--force", options->force, "replace an earlier launch in the output folder");
+  command->add_option("--report-period", options->report_period_s, "seconds between reports")
+      ->capture_default_str()
+      ->check(CLI::Range(0.2, 600.0));
+  command->callback([options] {
+    std::signal(SIGINT, onLaunchSignal);
+    std::signal(SIGTERM, onLaunchSignal);
+    const int status = run::launchScenario(*options, std::cout, g_stop_launch);
+    if (status != 0) throw CLI::RuntimeError(status);
+  });
+}
+
+}  // namespace nadir::cli

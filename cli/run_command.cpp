@@ -1,0 +1,58 @@
+// nadir run: one scenario through the whole pipeline in one process (run/run.h).
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "run/run.h"
+
+namespace nadir::cli {
+void printRunProgress(const run::RunProgress& progress) {
+  // On a terminal one line refreshed in place; in a log a line every 10 s of wall time.
+  static const bool tty = isatty(STDERR_FILENO) != 0;
+  static double last_printed_s = -1e9;
+  if (!tty && progress.wall_s - last_printed_s < 10.0) return;
+  last_printed_s = progress.wall_s;
+  const double speed = progress.wall_s > 0.0 ? progress.sim_s / progress.wall_s : 0.0;
+  std::fprintf(stderr, "%srun: t %7.1f s", tty ? "\r" : "", progress.sim_s);
+  if (progress.planned_s > 0.0) std::fprintf(stderr, " / %.0f s", progress.planned_s);
+  std::fprintf(stderr, " | %llu frames | %llu messages | %.1fx real time%s",
+               static_cast<unsigned long long>(progress.frames),
+               static_cast<unsigned long long>(progress.messages), speed, tty ? "   " : "\n");
+  std::fflush(stderr);
+}
+
+void endRunProgress() {
+  if (isatty(STDERR_FILENO) != 0) std::fprintf(stderr, "\n");
+}
+
+void printRunResult(const run::RunResult& result) {
+  std::cout << "\n" << result.table << "\n";
+  std::cout << "wrote " << result.log_path << " (replay: lcm-logplayer " << result.log_path
+            << ")\n      " << result.metrics_path << "\n";
+  for (const std::string& path : result.tum_paths) std::cout << "      " << path << "\n";
+  for (const std::string& path : result.picture_paths) std::cout << "      " << path << "\n";
+}
+
+void addRunCommand(CLI::App& app) {
+  auto options = std::make_shared<run::RunOptions>();
+  auto* command = app.add_subcommand(
+      "run",
+      "Fly a scenario through the whole pipeline in one process, in sim time; record, "
+      "evaluate and print the results");
+  command->add_option("scenario", options->scenario, "built-in scenario name or YAML file")
+      ->capture_default_str();
+  command->add_option("--out", options->out_dir, "output folder (default out/<scenario>)");
+  command->add_option("--set", options->overrides, "override a parameter: key=value (repeatable)");
+  command->add_flag("--force", options->force, "replace an earlier run in the output folder");
+  command->callback([options] {
+    const run::RunResult result = run::runScenario(*options, printRunProgress);
+    endRunProgress();
+    printRunResult(result);
+  });
+}
+
+}  // namespace nadir::cli

@@ -1,0 +1,52 @@
+// nadir sweep: a grid of runs in parallel and one table of results (run/sweep.h).
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "run/sweep.h"
+
+namespace nadir::cli {
+
+void addSweepCommand(CLI::App& app) {
+  auto path = std::make_shared<std::string>();
+  auto* command = app.add_subcommand(
+      "sweep", "Run a grid of parameter values (SWEEP.yaml) as parallel runs; write one table");
+  command->add_option("sweep", *path, "the sweep file")->required()->check(CLI::ExistingFile);
+  command->callback([path] {
+    const run::SweepSpec spec = run::loadSweep(*path);
+    const bool tty = isatty(STDERR_FILENO) != 0;
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+    const auto cells = run::runSweep(spec, self, [tty](const run::SweepProgress& p) {
+      const double eta =
+          p.done > 0 ? p.elapsed_s / static_cast<double>(p.done) * (p.total - p.done) : 0.0;
+      std::fprintf(stderr, "%ssweep: %zu/%zu done (%zu failed), %zu running, %.0f s elapsed",
+                   tty ? "\r" : "", p.done, p.total, p.failed, p.running, p.elapsed_s);
+      if (p.done > 0 && p.done < p.total) std::fprintf(stderr, ", about %.0f s to go", eta);
+      std::fprintf(stderr, tty ? "   " : "\n");
+      std::fflush(stderr);
+    });
+    if (tty) std::fprintf(stderr, "\n");
+    const std::filesystem::path out(spec.out_dir);
+    std::ofstream(out / "results.csv") << run::sweepCsv(spec, cells);
+    const std::string markdown = run::sweepMarkdown(spec, cells);
+    std::ofstream(out / "results.md") << markdown;
+    std::cout << markdown << "\nwrote " << (out / "results.csv").string() << " and "
+              << (out / "results.md").string() << "\n";
+    std::size_t failed = 0;
+    for (const run::SweepCell& cell : cells) {
+      if (!cell.metrics) {
+        ++failed;
+        std::cerr << "sweep: " << cell.out_dir << ": " << cell.error << "\n";
+      }
+    }
+    if (failed > 0) throw CLI::RuntimeError(1);
+  });
+}
+
+}  // namespace nadir::cli

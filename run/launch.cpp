@@ -1,0 +1,238 @@
+#include "run/launch.h"
+
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "core/bus.h"
+#include "core/clock.h"
+#include "nadir/vo_estimate_t.hpp"
+#include "nodes/sim/simulator.h"
+#include "run/process.h"
+#include "scenario/scenario.h"
+#include "terrain/world_factory.h"
+
+namespace nadir::run {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+bool fileContains(const std::string& path, const std::string& text) {
+  std::ifstream in(path);
+  std::stringstream content;
+  content << in.rdbuf();
+  return content.str().find(text) != std::string::npos;
+}
+
+std::string programPath(const std::string& bin_dir, const std::string& name) {
+  const fs::path path = fs::path(bin_dir) / name;
+  if (!fs::exists(path)) throw std::runtime_error("cannot find " + path.string());
+  return path.string();
+}
+
+std::string selfDirectory() {
+  std::error_code error;
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
+  return error ? std::string(".") : self.parent_path().string();
+}
+
+struct ChannelHealth {
+  std::int64_t total = 0;
+  std::int64_t window = 0;
+  double expected_hz = 0.0;
+  int vo_status = -1;
+};
+
+}  // namespace
+
+int launchScenario(const LaunchOptions& options, std::ostream& out, const std::atomic<bool>& stop) {
+  const scenario::ScenarioParams scenario =
+      scenario::loadScenario(options.scenario, options.overrides);
+  {
+    // Refuse what nadir-sim would refuse before any process starts.
+    const terrain::BuiltWorld built = terrain::makeWorld(scenario.world);
+    sim::Simulator check(scenario.sim, built.world, core::LocalNedFrame(built.origin));
+  }
+  if (scenario.time.mode != "realtime") {
+    throw std::runtime_error(
+        "nadir launch runs in real time (time.mode=realtime); for batch "
+        "runs use nadir run");
+  }
+  const std::string out_dir =
+      options.out_dir.empty()
+          ? (fs::path("out") / (fs::path(options.scenario).stem().string() + "-live")).string()
+          : options.out_dir;
+  const fs::path out_path(out_dir);
+  const fs::path recording = out_path / "launch.lcmlog";
+  if (!options.force && fs::exists(recording)) {
+    throw std::runtime_error(out_dir +
+                             " already holds a launch (launch.lcmlog); choose another "
+                             "--out or pass --force to replace it");
+  }
+  fs::create_directories(out_path);
+  const std::string bin_dir = options.bin_dir.empty() ? selfDirectory() : options.bin_dir;
+  const std::string url = scenario.bus.resolvedUrl();
+
+  std::vector<std::string> scenario_args = {options.scenario};
+  for (const std::string& assignment : options.overrides) {
+    scenario_args.push_back("--set");
+    scenario_args.push_back(assignment);
+  }
+  const auto nodeLog = [&](const std::string& name) {
+    return (out_path / (name + ".log")).string();
+  };
+  const auto withScenario = [&scenario_args](std::vector<std::string> argv) {
+    argv.insert(argv.end(), scenario_args.begin(), scenario_args.end());
+    return argv;
+  };
+  ChildProcess logger("lcm-logger", {"lcm-logger", "--lcm-url=" + url, "-f", recording.string()},
+                      nodeLog("lcm-logger"));
+  ChildProcess camera("nadir-camera",
+                      withScenario({programPath(bin_dir, "nadir-camera"), "--scenario"}),
+                      nodeLog("camera"));
+  ChildProcess simulator("nadir-sim", withScenario({programPath(bin_dir, "nadir-sim")}),
+                         nodeLog("sim"));
+  std::vector<ChildProcess*> nodes = {&logger, &camera, &simulator};
+
+  // Health: what arrives on the bus, against what the scenario should produce.
+  auto bus = core::openBus(scenario.bus);
+  std::map<std::string, ChannelHealth> channels;
+  channels[scenario.sim.truth.channel].expected_hz = scenario.sim.truth.rate_hz;
+  for (const auto& [name, spec] : scenario.allCameras())
+    channels[spec.channel].expected_hz = spec.fps;
+  const std::vector<std::string> vo_channels = {"POSE_PPA", "POSE_VO_FEATURE", "POSE_VO_DIRECT"};
+  auto subscription = bus->subscribe(".*", [&](const core::RawMessage& raw) {
+    ChannelHealth& health = channels[std::string(raw.channel)];
+    ++health.total;
+    ++health.window;
+    if (std::find(vo_channels.begin(), vo_channels.end(), raw.channel) != vo_channels.end()) {
+      nadir::vo_estimate_t estimate;
+      if (estimate.decode(raw.data, 0, static_cast<int>(raw.size)) > 0) {
+        health.vo_status = estimate.status;
+      }
+    }
+  });
+
+  out << "launch: " << options.scenario << " on " << url << "; node logs and the recording in "
+      << out_dir << "\n";
+  int result = 0;
+  const auto stopAll = [&] {
+    for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) (*it)->stop(5.0);
+  };
+  const auto failed = [&](const ChildProcess& node) {
+    out << "launch: " << node.name() << " died (" << node.describeExit() << "); see "
+        << node.logPath() << "\n";
+    result = 1;
+  };
+  try {
+    logger.start();
+    camera.start();
+    // The camera builds its world and GL context before it listens; wait for it.
+    const auto ready_deadline = Clock::now() + std::chrono::seconds(120);
+    while (!fileContains(camera.logPath(), "bus: ")) {
+      if (!camera.running()) {
+        failed(camera);
+        stopAll();
+        return result;
+      }
+      if (stop || Clock::now() > ready_deadline) {
+        out << "launch: " << (stop ? "stopped" : "nadir-camera not ready after 120 s") << "\n";
+        stopAll();
+        return stop ? 130 : 1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    simulator.start();
+    out << "launch: nadir-sim started; Ctrl-C stops every node\n";
+
+    const auto started = Clock::now();
+    auto last_report = started;
+    while (true) {
+      bus->handle(std::chrono::milliseconds(50));
+      if (stop) {
+        out << "launch: stopping\n";
+        stopAll();
+        result = 130;
+        break;
+      }
+      if (!simulator.running()) {
+        if (simulator.exitStatus() != 0) {
+          failed(simulator);
+          stopAll();
+          break;
+        }
+        out << "launch: the scenario has ended\n";
+        // Let the last frames and estimates arrive and be recorded.
+        const auto tail_end = Clock::now() + std::chrono::seconds(2);
+        while (Clock::now() < tail_end) bus->handle(std::chrono::milliseconds(50));
+        stopAll();
+        break;
+      }
+      bool node_died = false;
+      for (ChildProcess* node : nodes) {
+        if (node != &simulator && !node->running()) {
+          failed(*node);
+          node_died = true;
+        }
+      }
+      if (node_died) {
+        stopAll();
+        break;
+      }
+      const auto now = Clock::now();
+      const double window_s = std::chrono::duration<double>(now - last_report).count();
+      if (window_s >= options.report_period_s) {
+        last_report = now;
+        char line[256];
+        std::snprintf(line, sizeof(line), "launch: %.0f s",
+                      std::chrono::duration<double>(now - started).count());
+        out << line << "\n";
+        for (auto& [name, health] : channels) {
+          std::snprintf(line, sizeof(line), "  %-18s %8.1f Hz", name.c_str(),
+                        static_cast<double>(health.window) / window_s);
+          out << line;
+          if (health.expected_hz > 0.0) {
+            std::snprintf(line, sizeof(line), " (expected %.1f)",
+                          health.expected_hz * scenario.time.speed);
+            out << line;
+          }
+          if (health.vo_status >= 0) {
+            static const char* kStatus[] = {"INITIALIZING", "TRACKING", "LOST"};
+            out << " " << (health.vo_status <= 2 ? kStatus[health.vo_status] : "?");
+          }
+          out << "\n";
+          health.window = 0;
+        }
+        out.flush();
+      }
+    }
+  } catch (...) {
+    stopAll();
+    throw;
+  }
+  out << "launch: nodes\n";
+  for (const ChildProcess* node : nodes) {
+    const bool clean =
+        node->exitStatus() == 0 || (node->stoppedByUs() && node->exitStatus() != 128 + SIGKILL);
+    out << "  " << node->name() << ": " << node->describeExit()
+        << (node->stoppedByUs() ? " (stopped by launch)" : "") << (clean ? "" : "  <- problem")
+        << "\n";
+    if (!clean && result == 0) result = 1;
+  }
+  out << "launch: messages received\n";
+  for (const auto& [name, health] : channels) out << "  " << name << ": " << health.total << "\n";
+  out << "launch: recording " << recording.string() << "\n";
+  return result;
+}
+
+}  // namespace nadir::run

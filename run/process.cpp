@@ -1,0 +1,73 @@
+#include "run/process.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+
+extern char** environ;
+
+namespace nadir::run {
+
+ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv, std::string log_path)
+    : name_(std::move(name)), argv_(std::move(argv)), log_path_(std::move(log_path)) {}
+
+ChildProcess::~ChildProcess() { stop(2.0); }
+
+void ChildProcess::start() {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path_.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  std::vector<char*> argv;
+  for (std::string& arg : argv_) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const int error = posix_spawnp(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) {
+    pid_ = -1;
+    throw std::runtime_error("cannot start " + argv_[0] + ": " + std::strerror(error));
+  }
+  running_ = true;
+}
+
+bool ChildProcess::running() {
+  if (!running_) return false;
+  int status = 0;
+  if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
+  running_ = false;
+  exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return false;
+}
+
+void ChildProcess::stop(double grace_s) {
+  if (!running()) return;
+  stopped_by_us_ = true;
+  kill(pid_, SIGINT);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
+  while (running() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (running()) {
+    kill(pid_, SIGKILL);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    running_ = false;
+    exit_status_ = 128 + SIGKILL;
+  }
+}
+
+std::string ChildProcess::describeExit() const {
+  if (exit_status_ >= 128) return "killed by signal " + std::to_string(exit_status_ - 128);
+  return "exit status " + std::to_string(exit_status_);
+}
+
+}  // namespace nadir::run

@@ -1,0 +1,131 @@
+#include "run/run.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "core/bus.h"
+#include "core/clock.h"
+#include "core/lcm_log.h"
+#include "eval/trajectory.h"
+#include "nodes/camera/camera_messages.h"
+#include "nodes/camera/camera_node.h"
+#include "nodes/sim/sim_node.h"
+#include "nodes/sim/simulator.h"
+#include "run/track_plot.h"
+#include "scenario/scenario.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace nadir::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The files a run writes; an earlier run's are not overwritten without force.
+constexpr const char* kLogName = "run.lcmlog";
+constexpr const char* kMetricsName = "metrics.json";
+constexpr const char* kScenarioName = "scenario.yaml";
+
+std::string defaultOutDir(const std::string& scenario) {
+  return (fs::path("out") / fs::path(scenario).stem()).string();
+}
+
+}  // namespace
+
+RunResult runScenario(const RunOptions& options,
+                      const std::function<void(const RunProgress&)>& on_progress) {
+  scenario::ScenarioParams scenario = scenario::loadScenario(options.scenario, options.overrides);
+  // Everything stays in this process: the bus is in-process whatever the file says.
+  scenario.bus.url = "memq://";
+
+  RunResult result;
+  result.out_dir = options.out_dir.empty() ? defaultOutDir(options.scenario) : options.out_dir;
+  const fs::path out(result.out_dir);
+  if (!options.force && (fs::exists(out / kLogName) || fs::exists(out / kMetricsName))) {
+    throw std::runtime_error(result.out_dir + " already holds a run (" + kLogName +
+                             "); choose another --out or pass --force to replace it");
+  }
+  fs::create_directories(out);
+  result.log_path = (out / kLogName).string();
+  result.metrics_path = (out / kMetricsName).string();
+  std::ofstream(out / kScenarioName)
+      << "# nadir run " << options.scenario << ": the effective scenario\n"
+      << core::formatParamsOf(scenario);
+
+  auto bus = core::openBus(scenario.bus);
+  core::LcmLogWriter log(result.log_path);
+  // Every message is recorded at its own (sim) time.
+  core::Subscription recorder = bus->subscribe(".*", [&log, &result](const core::RawMessage& raw) {
+    log.write(core::peekUtime(raw).value_or(0), std::string(raw.channel), raw.data, raw.size);
+    ++result.totals.messages;
+  });
+
+  camera::CameraNode camera(*bus, scenario::cameraNodeParams(scenario));
+  // The main camera's last image, for a picture of what it saw.
+  nadir::image_t last_image;
+  core::Subscription last_image_keeper = core::subscribe<nadir::image_t>(
+      *bus, scenario.camera.channel,
+      [&last_image](const nadir::image_t& image) { last_image = image; });
+  const core::LocalNedFrame frame(camera.scene().built.origin);
+  sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
+                           sim::loadFlight(scenario.sim.flight, frame));
+  sim::SimPublisher publisher(*bus, scenario.sim, simulator);
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  auto last_report = wall_start;
+  const auto report = [&](bool force_report) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!on_progress || (!force_report && now - last_report < std::chrono::milliseconds(500))) {
+      return;
+    }
+    last_report = now;
+    result.totals.wall_s = std::chrono::duration<double>(now - wall_start).count();
+    result.totals.frames = camera.framesPublished();
+    on_progress(result.totals);
+  };
+  result.totals.planned_s = scenario.sim.duration_s;
+  while (!simulator.finished()) {
+    const sim::SimOutput output = simulator.step();
+    result.totals.sim_s = core::secondsFromUtime(output.truth.utime - simulator.startUtime());
+    publisher.publish(output);
+    // Deliver everything this step caused (images, estimates) before the next step.
+    while (bus->handle(std::chrono::milliseconds(0))) {
+    }
+    report(false);
+  }
+  result.totals.frames = camera.framesPublished();
+  report(true);
+  log.flush();
+
+  const eval::LogTrajectories recorded = eval::readRunLog(result.log_path);
+  const eval::EvalOptions eval_options;
+  result.metrics = eval::evaluate(recorded.truth, recorded.sources, eval_options);
+  eval::writeMetricsJson(result.metrics_path, result.metrics, eval_options);
+  const std::string truth_tum = (out / "truth.tum").string();
+  eval::writeTum(truth_tum, recorded.truth);
+  result.tum_paths.push_back(truth_tum);
+  std::map<std::string, eval::PoseTrajectory> tracked_sources;
+  for (const auto& [name, estimates] : recorded.sources) {
+    for (const eval::SourceEstimate& estimate : estimates) {
+      if (estimate.status == eval::SourceEstimate::kTracking)
+        tracked_sources[name].push_back({estimate.t_s, estimate.p_m, estimate.q});
+    }
+  }
+  result.picture_paths.push_back((out / "tracks.png").string());
+  writeTrackPlot(result.picture_paths.back(), recorded.truth, tracked_sources,
+                 fs::path(options.scenario).stem().string() + ": top view");
+  if (!last_image.data.empty()) {
+    result.picture_paths.push_back((out / "last_frame.png").string());
+    cv::imwrite(result.picture_paths.back(), camera::imageFromMessage(last_image));
+  }
+  for (const auto& [name, tracked] : tracked_sources) {
+    result.tum_paths.push_back((out / (name + ".tum")).string());
+    eval::writeTum(result.tum_paths.back(), tracked);
+  }
+  result.table = eval::formatResultsTable(result.metrics);
+  return result;
+}
+
+}  // namespace nadir::run

@@ -1,0 +1,55 @@
+#pragma once
+// `nadir run`: one scenario flown by the whole pipeline in one process, in sim
+// time, deterministically: the simulator drives an in-process bus on which
+// the same node classes the live programs run (cameras, VO nodes) receive and
+// publish; everything published is recorded to DIR/run.lcmlog, then
+// evaluated into DIR/metrics.json, TUM files and a results table.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "eval/run_metrics.h"
+
+namespace nadir::run {
+
+struct RunOptions {
+  // Built-in scenario name or YAML path.
+  std::string scenario = "default";
+  std::vector<std::string> overrides;
+  // Output folder; empty: out/<scenario name>.
+  std::string out_dir;
+  // Replace the files of an earlier run in out_dir (otherwise refused).
+  bool force = false;
+};
+
+struct RunProgress {
+  double sim_s = 0.0;
+  // Expected length of the flight, s, when known (duration_s or a recorded flight); else 0.
+  double planned_s = 0.0;
+  double wall_s = 0.0;
+  std::uint64_t frames = 0;
+  std::uint64_t messages = 0;
+};
+
+struct RunResult {
+  std::string out_dir;
+  std::string log_path;
+  std::string metrics_path;
+  std::vector<std::string> tum_paths;
+  // tracks.png (top view) and last_frame.png (the main camera's last image).
+  std::vector<std::string> picture_paths;
+  eval::RunMetrics metrics;
+  RunProgress totals;
+  std::string table;
+};
+
+// Flies the scenario and evaluates it. on_progress is called about every
+// half second of wall time. Throws core::ParamError for a bad scenario or
+// override, std::runtime_error naming the folder if out_dir holds an earlier
+// run and force is not set.
+RunResult runScenario(const RunOptions& options,
+                      const std::function<void(const RunProgress&)>& on_progress = {});
+
+}  // namespace nadir::run

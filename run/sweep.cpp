@@ -1,0 +1,305 @@
+#include "run/sweep.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <set>
+#include <thread>
+
+#include "core/params.h"
+#include "run/process.h"
+
+namespace nadir::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key,
+                       const std::string& problem) {
+  const std::string where =
+      node.Mark().is_null() ? path : path + ":" + std::to_string(node.Mark().line + 1);
+  throw core::ParamError(where + ": " + key + ": " + problem);
+}
+
+std::string lastPart(const std::string& key) {
+  const auto dot = key.rfind('.');
+  return dot == std::string::npos ? key : key.substr(dot + 1);
+}
+
+// The sources any cell reports, in name order.
+std::vector<std::string> sourceNames(const std::vector<SweepCell>& cells) {
+  std::set<std::string> names;
+  for (const SweepCell& cell : cells) {
+    if (!cell.metrics) continue;
+    for (const auto& entry : cell.metrics->sources) names.insert(entry.first);
+  }
+  return {names.begin(), names.end()};
+}
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3f", value);
+  return text;
+}
+
+const eval::SourceMetrics* sourceOf(const SweepCell& cell, const std::string& name) {
+  if (!cell.metrics) return nullptr;
+  const auto it = cell.metrics->sources.find(name);
+  return it == cell.metrics->sources.end() ? nullptr : &it->second;
+}
+
+}  // namespace
+
+SweepSpec loadSweep(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw core::ParamError(path + ": cannot open sweep file");
+  } catch (const YAML::ParserException& e) {
+    throw core::ParamError(path + ":" + std::to_string(e.mark.line + 1) +
+                           ": not valid YAML: " + e.msg);
+  }
+  if (!root.IsMap())
+    throw core::ParamError(path + ": expected a map (scenario, out, jobs, set, axes)");
+  SweepSpec spec;
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    const YAML::Node& value = entry.second;
+    try {
+      if (key == "scenario") {
+        spec.scenario = value.as<std::string>();
+      } else if (key == "out") {
+        spec.out_dir = value.as<std::string>();
+      } else if (key == "jobs") {
+        spec.jobs = value.as<int>();
+        if (spec.jobs < 1) fail(path, value, key, "must be at least 1");
+      } else if (key == "set") {
+        spec.shared_overrides = value.as<std::vector<std::string>>();
+      } else if (key == "axes") {
+        if (!value.IsMap()) fail(path, value, key, "expected a map of key: [values]");
+        for (const auto& axis : value) {
+          SweepAxis parsed{axis.first.as<std::string>(), {}};
+          if (!axis.second.IsSequence() || axis.second.size() == 0) {
+            fail(path, axis.second, "axes." + parsed.key, "expected a non-empty list of values");
+          }
+          for (const auto& v : axis.second) {
+            if (!v.IsScalar()) fail(path, v, "axes." + parsed.key, "values must be scalars");
+            parsed.values.push_back(v.Scalar());
+          }
+          spec.axes.push_back(std::move(parsed));
+        }
+      } else {
+        fail(path, entry.first, key, "unknown key (known: scenario, out, jobs, set, axes)");
+      }
+    } catch (const YAML::BadConversion&) {
+      fail(path, value, key, "has the wrong type");
+    }
+  }
+  if (spec.scenario.empty()) throw core::ParamError(path + ": scenario: missing");
+  if (spec.axes.empty()) throw core::ParamError(path + ": axes: missing (nothing to sweep)");
+  return spec;
+}
+
+std::vector<SweepCell> planSweep(const SweepSpec& spec) {
+  std::vector<SweepCell> cells(1);
+  for (const SweepAxis& axis : spec.axes) {
+    std::vector<SweepCell> next;
+    for (const SweepCell& cell : cells) {
+      for (const std::string& value : axis.values) {
+        SweepCell extended = cell;
+        extended.values.push_back(value);
+        next.push_back(std::move(extended));
+      }
+    }
+    cells = std::move(next);
+  }
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    char index[32];
+    std::snprintf(index, sizeof(index), "%03zu", i);
+    std::string name = std::string("cell_") + index;
+    for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+      name.append(1, '_')
+          .append(lastPart(spec.axes[a].key))
+          .append(1, '=')
+          .append(cells[i].values[a]);
+    }
+    cells[i].out_dir = (fs::path(spec.out_dir) / name).string();
+  }
+  return cells;
+}
+
+std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_program,
+                                const std::function<void(const SweepProgress&)>& on_progress) {
+  std::vector<SweepCell> cells = planSweep(spec);
+  const std::size_t jobs = spec.jobs > 0 ? static_cast<std::size_t>(spec.jobs)
+                                         : std::max(1u, std::thread::hardware_concurrency());
+  SweepProgress progress;
+  progress.total = cells.size();
+  const auto started = std::chrono::steady_clock::now();
+  std::map<std::size_t, std::unique_ptr<ChildProcess>> running;
+  std::size_t next = 0;
+  while (next < cells.size() || !running.empty()) {
+    while (next < cells.size() && running.size() < jobs) {
+      SweepCell& cell = cells[next];
+      fs::create_directories(cell.out_dir);
+      std::vector<std::string> argv = {nadir_program, "run",        spec.scenario,
+                                       "--out",       cell.out_dir, "--force"};
+      for (const std::string& assignment : spec.shared_overrides) {
+        argv.push_back("--set");
+        argv.push_back(assignment);
+      }
+      for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+        argv.push_back("--set");
+        argv.push_back(spec.axes[a].key + "=" + cell.values[a]);
+      }
+      auto child = std::make_unique<ChildProcess>("run " + std::to_string(next), argv,
+                                                  (fs::path(cell.out_dir) / "run.out").string());
+      child->start();
+      running.emplace(next++, std::move(child));
+    }
+    for (auto it = running.begin(); it != running.end();) {
+      if (it->second->running()) {
+        ++it;
+        continue;
+      }
+      SweepCell& cell = cells[it->first];
+      cell.exit_status = it->second->exitStatus();
+      const fs::path metrics = fs::path(cell.out_dir) / "metrics.json";
+      if (cell.exit_status == 0) {
+        try {
+          cell.metrics = eval::readMetricsJson(metrics.string());
+        } catch (const std::exception& error) {
+          cell.error = error.what();
+        }
+      } else {
+        cell.error = it->second->describeExit() + " (see " + it->second->logPath() + ")";
+      }
+      ++progress.done;
+      if (!cell.metrics) ++progress.failed;
+      it = running.erase(it);
+    }
+    progress.running = running.size();
+    progress.elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (on_progress) on_progress(progress);
+    if (!running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  return cells;
+}
+
+std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
+  const std::vector<std::string> sources = sourceNames(cells);
+  std::string csv;
+  for (const SweepAxis& axis : spec.axes) csv += axis.key + ",";
+  csv += "run,truth_track_length_m";
+  for (const std::string& source : sources) {
+    csv += "," + source + ".position_rmse_m," + source + ".rotation_rmse_deg," + source +
+           ".tracked_pct";
+  }
+  csv += "\n";
+  for (const SweepCell& cell : cells) {
+    for (const std::string& value : cell.values) csv += value + ",";
+    csv += cell.metrics ? "ok," + number(cell.metrics->truth_track_length_m) : "failed,";
+    for (const std::string& source : sources) {
+      const eval::SourceMetrics* metrics = sourceOf(cell, source);
+      if (metrics == nullptr) {
+        csv += ",,,";
+      } else if (!metrics->initialised) {
+        csv += ",X,X," + number(0.0);
+      } else {
+        csv += "," + number(metrics->position_rmse_m) + "," + number(metrics->rotation_rmse_deg) +
+               "," + number(metrics->tracked_pct);
+      }
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
+  const std::vector<std::string> sources = sourceNames(cells);
+  const bool split = spec.axes.size() >= 3;
+  const std::size_t first_row_axis = split ? 1 : 0;
+  std::string md = "# Sweep: " + spec.scenario + "\n\n";
+  if (sources.empty()) {
+    md += "No pose source (VO node) ran in these cells: the table holds the truth only.\n\n";
+  }
+  const auto header = [&] {
+    std::string line = "|", rule = "|";
+    for (std::size_t a = first_row_axis; a < spec.axes.size(); ++a) {
+      line.append(" ").append(spec.axes[a].key).append(" |");
+      rule += "---|";
+    }
+    line += " track (m) |";
+    rule += "---|";
+    for (const char* metric : {"position RMSE (m)", "rotation RMSE (deg)", "tracked (%)"}) {
+      for (const std::string& source : sources) {
+        line.append(" ").append(metric).append(" ").append(source).append(" |");
+        rule += "---|";
+      }
+    }
+    return line + "\n" + rule + "\n";
+  };
+  const auto row = [&](const SweepCell& cell) {
+    std::string line = "|";
+    for (std::size_t a = first_row_axis; a < cell.values.size(); ++a) {
+      line.append(" ").append(cell.values[a]).append(" |");
+    }
+    if (!cell.metrics) {
+      line += " failed |";
+      for (std::size_t i = 0; i < 3 * sources.size(); ++i) line += " failed |";
+      return line + "\n";
+    }
+    line.append(" ").append(number(cell.metrics->truth_track_length_m)).append(" |");
+    // The lowest position and rotation error of the row in bold, as in the thesis.
+    double best_position = 1e300, best_rotation = 1e300;
+    for (const std::string& source : sources) {
+      const eval::SourceMetrics* m = sourceOf(cell, source);
+      if (m != nullptr && m->initialised) {
+        best_position = std::min(best_position, m->position_rmse_m);
+        best_rotation = std::min(best_rotation, m->rotation_rmse_deg);
+      }
+    }
+    for (int metric = 0; metric < 3; ++metric) {
+      for (const std::string& source : sources) {
+        const eval::SourceMetrics* m = sourceOf(cell, source);
+        if (m == nullptr) {
+          line += " |";
+        } else if (metric < 2 && !m->initialised) {
+          line += " X |";
+        } else {
+          const double value = metric == 0   ? m->position_rmse_m
+                               : metric == 1 ? m->rotation_rmse_deg
+                                             : m->tracked_pct;
+          const bool best =
+              (metric == 0 && value == best_position) || (metric == 1 && value == best_rotation);
+          const bool bold = best && sources.size() > 1;
+          line.append(bold ? " **" : " ").append(number(value)).append(bold ? "** |" : " |");
+        }
+      }
+    }
+    return line + "\n";
+  };
+  if (!split) {
+    md += header();
+    for (const SweepCell& cell : cells) md += row(cell);
+    return md;
+  }
+  for (const std::string& value : spec.axes.front().values) {
+    md.append("## ").append(spec.axes.front().key).append(" = ").append(value).append("\n\n");
+    md += header();
+    for (const SweepCell& cell : cells) {
+      if (cell.values.front() == value) md += row(cell);
+    }
+    md += "\n";
+  }
+  return md;
+}
+
+}  // namespace nadir::run

@@ -1,0 +1,73 @@
+#pragma once
+// `nadir sweep`: a grid of parameter values (the thesis's experiment grid)
+// flown cell by cell by `nadir run` child processes in parallel, then one
+// table of position RMSE, rotation RMSE and robustness per cell and per VO,
+// laid out like the thesis's tables 1 and 2 (seed 002).
+//
+// SWEEP.yaml:
+//   scenario: thesis-oscillating
+//   out: out/sweep                 # one folder per cell under it
+//   jobs: 2                        # runs at once (default: the number of cores)
+//   set: ["camera.fps=31"]         # overrides every cell shares
+//   axes:                          # in order; the first splits the tables
+//     vehicle.airspeed_mps: [10, 25]
+//     vehicle.max_roll_rate_dps: [25, 45, 65]
+//     vehicle.altitude_agl_m: [50, 100, 150, 200, 250, 300, 350, 400]
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "eval/run_metrics.h"
+
+namespace nadir::run {
+
+struct SweepAxis {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+struct SweepSpec {
+  std::string scenario;
+  std::string out_dir = "out/sweep";
+  int jobs = 0;
+  std::vector<std::string> shared_overrides;
+  std::vector<SweepAxis> axes;
+};
+
+// Throws core::ParamError naming the file, line and problem.
+SweepSpec loadSweep(const std::string& path);
+
+struct SweepCell {
+  // One value per axis, in axis order.
+  std::vector<std::string> values;
+  std::string out_dir;
+  int exit_status = -1;
+  std::optional<eval::RunMetrics> metrics;
+  // Why the cell has no metrics (the run failed: see its run.out).
+  std::string error;
+};
+
+// Every combination of the axes' values, the last axis varying fastest.
+std::vector<SweepCell> planSweep(const SweepSpec& spec);
+
+struct SweepProgress {
+  std::size_t done = 0, failed = 0, running = 0, total = 0;
+  double elapsed_s = 0.0;
+};
+
+// Runs `nadir_program run` for every cell, spec.jobs at a time, and reads each
+// cell's metrics.json. A failed cell is kept with its error; the others go on.
+std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_program,
+                                const std::function<void(const SweepProgress&)>& on_progress);
+
+// The results: one CSV row per cell, and Markdown tables like the thesis's
+// (one table per value of the first axis when there are three or more axes;
+// rows the other axes; per source position RMSE, rotation RMSE and tracked %,
+// X where a source never initialised, the lowest error of a row in bold).
+std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells);
+std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells);
+
+}  // namespace nadir::run

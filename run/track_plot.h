@@ -1,0 +1,17 @@
+#pragma once
+// A top view of the truth and every pose source's track, as a PNG: north up,
+// east right, equal scale, a scale bar and a legend.
+
+#include <map>
+#include <string>
+
+#include "eval/trajectory.h"
+
+namespace nadir::run {
+
+// Throws std::runtime_error naming the path if it cannot be written.
+void writeTrackPlot(const std::string& png_path, const eval::PoseTrajectory& truth,
+                    const std::map<std::string, eval::PoseTrajectory>& sources,
+                    const std::string& title);
+
+}  // namespace nadir::run

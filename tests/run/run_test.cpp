@@ -1,0 +1,243 @@
+// nadir run, launch and sweep: determinism, replay, live processes and tables.
+
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+
+#include "core/bus.h"
+#include "core/lcm_log.h"
+#include "eval/run_metrics.h"
+#include "run/launch.h"
+#include "run/run.h"
+#include "run/sweep.h"
+
+namespace nadir::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string tempDir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("nadir_run_" + name);
+  fs::remove_all(dir);
+  return dir.string();
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+RunOptions shortRun(const std::string& out_dir) {
+  RunOptions options;
+  options.scenario = "default";
+  options.out_dir = out_dir;
+  options.overrides = {"duration_s=3", "camera.width=320", "camera.height=240"};
+  return options;
+}
+
+// A run writes its log, metrics, truth TUM, pictures and the effective scenario; the
+// log holds the truth at 400 Hz and the camera at 20 frames/s, all at sim time.
+TEST(Run, WritesItsFiles) {
+  const RunResult result = runScenario(shortRun(tempDir("files")));
+  for (const char* name : {"run.lcmlog", "metrics.json", "truth.tum", "tracks.png",
+                           "last_frame.png", "scenario.yaml"}) {
+    EXPECT_TRUE(fs::exists(fs::path(result.out_dir) / name)) << name;
+  }
+  std::map<std::string, int> counts;
+  core::LcmLogReader reader(result.log_path);
+  std::int64_t last_truth_utime = -1;
+  while (auto event = reader.next()) {
+    ++counts[event->channel];
+    if (event->channel == "POSE_TRUTH") last_truth_utime = event->timestamp_utime;
+  }
+  EXPECT_EQ(counts["POSE_TRUTH"], 3 * 400 + 1);
+  EXPECT_EQ(counts["CAMERA_DOWN"], 3 * 20 + 1);
+  EXPECT_EQ(last_truth_utime, 3'000'000);
+  EXPECT_NEAR(result.metrics.truth_duration_s, 3.0, 1e-9);
+  EXPECT_NEAR(result.metrics.truth_track_length_m, 3.0 * 20.0, 0.5);  // 20 m/s airspeed, no wind
+}
+
+// Two runs of one scenario produce byte-identical logs.
+TEST(Run, TwoRunsGiveIdenticalLogs) {
+  const RunResult a = runScenario(shortRun(tempDir("same_a")));
+  const RunResult b = runScenario(shortRun(tempDir("same_b")));
+  const std::string log_a = readFile(a.log_path), log_b = readFile(b.log_path);
+  EXPECT_GT(log_a.size(), 1000000u);
+  EXPECT_TRUE(log_a == log_b) << "the logs differ";
+}
+
+// An earlier run is not overwritten unless asked to.
+TEST(Run, RefusesToOverwriteAnEarlierRun) {
+  RunOptions options = shortRun(tempDir("overwrite"));
+  options.overrides.push_back("duration_s=0.5");
+  runScenario(options);
+  try {
+    runScenario(options);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("already holds a run"), std::string::npos);
+  }
+  options.force = true;
+  EXPECT_NO_THROW(runScenario(options));
+}
+
+// The run's log replayed through the log bus and recorded again evaluates to the same metrics.
+TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
+  const RunResult result = runScenario(shortRun(tempDir("replay")));
+  const std::string replayed = (fs::path(result.out_dir) / "replayed.lcmlog").string();
+  {
+    auto player = core::openBus("file://" + result.log_path + "?mode=r&speed=0");
+    core::LcmLogWriter writer(replayed);
+    auto recorder = player->subscribe(".*", [&writer](const core::RawMessage& raw) {
+      writer.write(core::peekUtime(raw).value_or(0), std::string(raw.channel), raw.data, raw.size);
+    });
+    while (player->handle(std::chrono::milliseconds(0))) {
+    }
+  }
+  EXPECT_EQ(readFile(replayed), readFile(result.log_path));
+  const eval::LogTrajectories recorded = eval::readRunLog(replayed);
+  const eval::EvalOptions options;
+  const eval::RunMetrics metrics = eval::evaluate(recorded.truth, recorded.sources, options);
+  const std::string json = (fs::path(result.out_dir) / "replayed.json").string();
+  eval::writeMetricsJson(json, metrics, options);
+  EXPECT_EQ(readFile(json), readFile(result.metrics_path));
+}
+
+// A sweep file's grid: every combination, last axis fastest, named by its values.
+TEST(Sweep, PlansTheGrid) {
+  const std::string dir = tempDir("sweep_plan");
+  fs::create_directories(dir);
+  const std::string path = (fs::path(dir) / "sweep.yaml").string();
+  std::ofstream(path) << "scenario: thesis-oscillating\nout: " << dir
+                      << "\njobs: 2\nset: [camera.fps=5]\naxes:\n"
+                         "  vehicle.airspeed_mps: [10, 25]\n"
+                         "  vehicle.max_roll_rate_dps: [25, 45, 65]\n"
+                         "  vehicle.altitude_agl_m: [50, 100]\n";
+  const SweepSpec spec = loadSweep(path);
+  EXPECT_EQ(spec.jobs, 2);
+  ASSERT_EQ(spec.axes.size(), 3u);
+  const std::vector<SweepCell> cells = planSweep(spec);
+  ASSERT_EQ(cells.size(), 12u);
+  EXPECT_EQ(cells[0].values, (std::vector<std::string>{"10", "25", "50"}));
+  EXPECT_EQ(cells[1].values, (std::vector<std::string>{"10", "25", "100"}));
+  EXPECT_EQ(cells[11].values, (std::vector<std::string>{"25", "65", "100"}));
+  EXPECT_EQ(fs::path(cells[1].out_dir).filename(),
+            "cell_001_airspeed_mps=10_max_roll_rate_dps=25_altitude_agl_m=100");
+}
+
+// A sweep file with an unknown key or an empty axis is refused with the line named.
+TEST(Sweep, BadFilesAreRefused) {
+  const std::string dir = tempDir("sweep_bad");
+  fs::create_directories(dir);
+  const std::string path = (fs::path(dir) / "sweep.yaml").string();
+  std::ofstream(path) << "scenario: box\naxis:\n  vehicle.airspeed_mps: [10]\n";
+  try {
+    loadSweep(path);
+    FAIL() << "no error";
+  } catch (const core::ParamError& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ":2: axis: unknown key"), std::string::npos)
+        << error.what();
+  }
+  std::ofstream(path, std::ios::trunc) << "scenario: box\naxes:\n  vehicle.airspeed_mps: []\n";
+  EXPECT_THROW(loadSweep(path), core::ParamError);
+}
+
+eval::SourceMetrics sourceMetrics(bool initialised, double position, double rotation,
+                                  double tracked) {
+  eval::SourceMetrics metrics{};
+  metrics.initialised = initialised;
+  metrics.position_rmse_m = position;
+  metrics.rotation_rmse_deg = rotation;
+  metrics.tracked_pct = tracked;
+  return metrics;
+}
+
+// The results tables: one per value of the first axis, X where a source never initialised,
+// the lowest error of a row in bold, a failed run marked, and one CSV row per cell.
+TEST(Sweep, TablesLikeTheThesis) {
+  SweepSpec spec;
+  spec.scenario = "thesis-oscillating";
+  spec.axes = {{"vehicle.airspeed_mps", {"10", "25"}},
+               {"vehicle.max_roll_rate_dps", {"25"}},
+               {"vehicle.altitude_agl_m", {"50"}}};
+  std::vector<SweepCell> cells = planSweep(spec);
+  eval::RunMetrics metrics;
+  metrics.truth_track_length_m = 3203.0;
+  metrics.sources["vo_direct"] = sourceMetrics(true, 12.5, 3.25, 97.0);
+  metrics.sources["vo_feature"] = sourceMetrics(false, 0.0, 0.0, 0.0);
+  metrics.sources["ppa"] = sourceMetrics(true, 20.0, 1.5, 100.0);
+  cells[0].metrics = metrics;
+  cells[1].error = "exit status 1";
+  const std::string md = sweepMarkdown(spec, cells);
+  EXPECT_NE(md.find("## vehicle.airspeed_mps = 10"), std::string::npos) << md;
+  EXPECT_NE(md.find("## vehicle.airspeed_mps = 25"), std::string::npos) << md;
+  // Columns in source order: ppa, vo_direct, vo_feature.
+  EXPECT_NE(md.find("| 25 | 50 | 3203.000 | 20.000 | **12.500** | X | **1.500** | 3.250 | X | "
+                    "100.000 | 97.000 | 0.000 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 25 | 50 | failed |"), std::string::npos) << md;
+  const std::string csv = sweepCsv(spec, cells);
+  EXPECT_NE(csv.find("10,25,50,ok,3203.000,20.000,1.500,100.000,12.500,3.250,97.000,X,X,0.000"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("25,25,50,failed,"), std::string::npos) << csv;
+}
+
+// Live: the nodes start as processes, the scenario ends, every node stops cleanly and the
+// recording holds the truth and the camera. Needs UDP multicast (skipped without it).
+TEST(Launch, FliesAndStopsCleanly) {
+  const std::string dir = tempDir("launch");
+  LaunchOptions options;
+  options.scenario = "default";
+  options.out_dir = dir;
+  options.overrides = {"duration_s=2", "camera.width=160", "camera.height=120"};
+  options.bin_dir = NADIR_BIN_DIR;
+  options.report_period_s = 1.0;
+  std::atomic<bool> stop{false};
+  std::ostringstream out;
+  const int status = launchScenario(options, out, stop);
+  const std::string recording = (fs::path(dir) / "launch.lcmlog").string();
+  if (!fs::exists(recording) || fs::file_size(recording) == 0) {
+    GTEST_SKIP() << "UDP multicast does not reach this process here (see nadir doctor)\n"
+                 << out.str();
+  }
+  EXPECT_EQ(status, 0) << out.str();
+  EXPECT_NE(out.str().find("the scenario has ended"), std::string::npos) << out.str();
+  std::map<std::string, int> counts;
+  core::LcmLogReader reader(recording);
+  while (auto event = reader.next()) ++counts[event->channel];
+  EXPECT_GE(counts["POSE_TRUTH"], 2 * 400) << out.str();
+  EXPECT_GE(counts["CAMERA_DOWN"], 2 * 20) << out.str();
+}
+
+// A node that dies is reported with its exit status and stops the launch with status 1.
+TEST(Launch, ADeadNodeIsReported) {
+  const std::string dir = tempDir("launch_dead");
+  const fs::path bin = fs::path(dir) / "bin";
+  fs::create_directories(bin);
+  // A camera that says it is ready, then fails; the real simulator.
+  std::ofstream(bin / "nadir-camera") << "#!/bin/sh\necho 'bus: pretend'\nsleep 1\nexit 3\n";
+  fs::permissions(bin / "nadir-camera", fs::perms::owner_all);
+  fs::create_symlink(fs::path(NADIR_BIN_DIR) / "nadir-sim", bin / "nadir-sim");
+  LaunchOptions options;
+  options.scenario = "default";
+  options.out_dir = (fs::path(dir) / "out").string();
+  options.overrides = {"duration_s=30"};
+  options.bin_dir = bin.string();
+  std::atomic<bool> stop{false};
+  std::ostringstream out;
+  EXPECT_EQ(launchScenario(options, out, stop), 1) << out.str();
+  EXPECT_NE(out.str().find("nadir-camera died (exit status 3)"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("nadir-sim: "), std::string::npos) << out.str();
+}
+
+}  // namespace
+}  // namespace nadir::run
