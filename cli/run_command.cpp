@@ -48,6 +48,8 @@ void addRunCommand(CLI::App& app) {
   command->add_option("--out", options->out_dir, "output folder (default out/<scenario>)");
   command->add_option("--set", options->overrides, "override a parameter: key=value (repeatable)");
   command->add_flag("--force", options->force, "replace an earlier run in the output folder");
+  command->add_flag("--no-images{false}", options->record_images,
+                    "leave the camera images out of run.lcmlog (metrics are unchanged)");
   command->callback([options] {
     const run::RunResult result = run::runScenario(*options, printRunProgress);
     endRunProgress();

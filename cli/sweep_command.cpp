@@ -22,7 +22,11 @@ void addSweepCommand(CLI::App& app) {
     const run::SweepSpec spec = run::loadSweep(*path);
     const bool tty = isatty(STDERR_FILENO) != 0;
     const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-    const auto cells = run::runSweep(spec, self, [tty](const run::SweepProgress& p) {
+    std::size_t last_done = static_cast<std::size_t>(-1);
+    const auto cells = run::runSweep(spec, self, [tty, &last_done](const run::SweepProgress& p) {
+      // In a log, a line when a cell finishes; on a terminal, one line refreshed in place.
+      if (!tty && p.done == last_done) return;
+      last_done = p.done;
       const double eta =
           p.done > 0 ? p.elapsed_s / static_cast<double>(p.done) * (p.total - p.done) : 0.0;
       std::fprintf(stderr, "%ssweep: %zu/%zu done (%zu failed), %zu running, %.0f s elapsed",

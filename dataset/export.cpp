@@ -15,9 +15,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/bus.h"
+#include "core/clock.h"
 #include "core/frames.h"
 #include "core/lcm_log.h"
-#include "dataset/trajectory.h"
+#include "eval/trajectory.h"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
@@ -37,6 +38,14 @@ struct ImuSample {
   std::int64_t utime = 0;
   Eigen::Vector3d gyro_rps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+};
+
+// One pose_t of the truth channel: T_world_body (world local NED, body FRD).
+struct TruthSample {
+  std::int64_t utime = 0;
+  Eigen::Vector3d p_body_in_world_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d v_world_mps = Eigen::Vector3d::Zero();
 };
 
 struct Calibration {
@@ -395,13 +404,22 @@ void writeTumTrajectory(Context& context, const fs::path& path) {
   file << "# " + sourceLine(context) + ", truth from " + context.options.truth_channel + "\n";
   file << "# timestamp tx ty tz qx qy qz qw\n";
   std::int64_t missing = 0;
+  eval::PoseTrajectory truth;
+  for (const TruthSample& sample : context.scan.truth) {
+    truth.push_back(
+        {core::secondsFromUtime(sample.utime), sample.p_body_in_world_m, sample.q_world_body});
+  }
   for (const ImageRecord& image : context.images) {
-    const auto T_world_body = interpolatePose(context.scan.truth, image.utime, kMaxTruthGapUs);
-    if (!T_world_body) {
+    const auto body = eval::interpolate(truth, core::secondsFromUtime(image.utime),
+                                        core::secondsFromUtime(kMaxTruthGapUs));
+    if (!body) {
       ++missing;
       continue;
     }
-    const Eigen::Isometry3d T_world_cam = *T_world_body * context.calibration.T_body_cam;
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.linear() = body->q.toRotationMatrix();
+    T_world_body.translation() = body->p_m;
+    const Eigen::Isometry3d T_world_cam = T_world_body * context.calibration.T_body_cam;
     const Eigen::Vector3d p = T_world_cam.translation();
     const Eigen::Quaterniond q(T_world_cam.rotation());
     file << secondsText(image.utime) + " " + number(p.x()) + " " + number(p.y()) + " " +

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <stdexcept>
 
 #include "core/bus.h"
@@ -56,11 +57,18 @@ RunResult runScenario(const RunOptions& options,
 
   auto bus = core::openBus(scenario.bus);
   core::LcmLogWriter log(result.log_path);
-  // Every message is recorded at its own (sim) time.
-  core::Subscription recorder = bus->subscribe(".*", [&log, &result](const core::RawMessage& raw) {
-    log.write(core::peekUtime(raw).value_or(0), std::string(raw.channel), raw.data, raw.size);
-    ++result.totals.messages;
-  });
+  // Every message is recorded at its own (sim) time, images unless left out.
+  std::set<std::string> unrecorded;
+  if (!options.record_images) {
+    for (const auto& [name, spec] : scenario.allCameras()) unrecorded.insert(spec.channel);
+  }
+  core::Subscription recorder =
+      bus->subscribe(".*", [&log, &result, &unrecorded](const core::RawMessage& raw) {
+        ++result.totals.messages;
+        const std::string channel(raw.channel);
+        if (unrecorded.count(channel) != 0) return;
+        log.write(core::peekUtime(raw).value_or(0), channel, raw.data, raw.size);
+      });
 
   camera::CameraNode camera(*bus, scenario::cameraNodeParams(scenario));
   // The main camera's last image, for a picture of what it saw.

@@ -22,6 +22,9 @@ struct RunOptions {
   std::string out_dir;
   // Replace the files of an earlier run in out_dir (otherwise refused).
   bool force = false;
+  // Leave the camera images out of run.lcmlog (everything else is recorded):
+  // for sweeps, where a 1280x960 stream would write 38 MB per second of flight.
+  bool record_images = true;
 };
 
 struct RunProgress {

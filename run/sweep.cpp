@@ -79,6 +79,8 @@ SweepSpec loadSweep(const std::string& path) {
       } else if (key == "jobs") {
         spec.jobs = value.as<int>();
         if (spec.jobs < 1) fail(path, value, key, "must be at least 1");
+      } else if (key == "images") {
+        spec.images = value.as<bool>();
       } else if (key == "set") {
         spec.shared_overrides = value.as<std::vector<std::string>>();
       } else if (key == "axes") {
@@ -95,7 +97,7 @@ SweepSpec loadSweep(const std::string& path) {
           spec.axes.push_back(std::move(parsed));
         }
       } else {
-        fail(path, entry.first, key, "unknown key (known: scenario, out, jobs, set, axes)");
+        fail(path, entry.first, key, "unknown key (known: scenario, out, jobs, set, images, axes)");
       }
     } catch (const YAML::BadConversion&) {
       fail(path, value, key, "has the wrong type");
@@ -150,6 +152,7 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
       fs::create_directories(cell.out_dir);
       std::vector<std::string> argv = {nadir_program, "run",        spec.scenario,
                                        "--out",       cell.out_dir, "--force"};
+      if (!spec.images) argv.push_back("--no-images");
       for (const std::string& assignment : spec.shared_overrides) {
         argv.push_back("--set");
         argv.push_back(assignment);

@@ -9,6 +9,7 @@
 //   out: out/sweep                 # one folder per cell under it
 //   jobs: 2                        # runs at once (default: the number of cores)
 //   set: ["camera.fps=31"]         # overrides every cell shares
+//   images: false                  # record camera images in the cells' logs
 //   axes:                          # in order; the first splits the tables
 //     vehicle.airspeed_mps: [10, 25]
 //     vehicle.max_roll_rate_dps: [25, 45, 65]
@@ -35,6 +36,9 @@ struct SweepSpec {
   int jobs = 0;
   std::vector<std::string> shared_overrides;
   std::vector<SweepAxis> axes;
+  // Record the camera images in each cell's run.lcmlog (off: the logs hold
+  // everything else and the metrics are the same, at a fraction of the size).
+  bool images = false;
 };
 
 // Throws core::ParamError naming the file, line and problem.

@@ -9,6 +9,7 @@
 
 #include "core/clock.h"
 #include "core/frames.h"
+#include "eval/trajectory.h"
 
 namespace nadir::sim {
 namespace {
@@ -95,27 +96,15 @@ VehicleState Trajectory::at(std::int64_t utime) const {
 }
 
 Trajectory readTumTrajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw TrajectoryError("cannot open trajectory " + path);
+  eval::PoseTrajectory tum;
+  try {
+    tum = eval::readTum(path);
+  } catch (const eval::EvalError& error) {
+    throw TrajectoryError(error.what());
+  }
   std::vector<TrajectoryPose> poses;
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
-    double t = 0, x = 0, y = 0, z = 0, qx = 0, qy = 0, qz = 0, qw = 0;
-    if (!(fields >> t >> x >> y >> z >> qx >> qy >> qz >> qw)) {
-      throw TrajectoryError(path + ":" + std::to_string(line_number) +
-                            ": expected 'timestamp tx ty tz qx qy qz qw'");
-    }
-    const Eigen::Quaterniond q(qw, qx, qy, qz);
-    if (std::abs(q.norm() - 1.0) > 1e-3) {
-      throw TrajectoryError(path + ":" + std::to_string(line_number) +
-                            ": quaternion is not unit length");
-    }
-    poses.push_back({core::utimeFromSeconds(t), Eigen::Vector3d(x, y, z), q});
+  for (const eval::StampedPose& pose : tum) {
+    poses.push_back({core::utimeFromSeconds(pose.t_s), pose.p_m, pose.q});
   }
   return Trajectory(std::move(poses), path);
 }

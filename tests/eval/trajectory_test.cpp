@@ -116,6 +116,15 @@ TEST(EvalInterpolate, LinearPositionSlerpAttitude) {
   EXPECT_TRUE(interpolate(truth, 0.5, 2.0).has_value());
 }
 
+// SLERP takes the short way even when the second quaternion has the other sign.
+TEST(EvalInterpolate, SlerpTakesTheShortArc) {
+  PoseTrajectory truth = {poseAt(0, 0, 0, 0, 0), poseAt(1, 0, 0, 0, 90)};
+  truth[1].q.coeffs() *= -1.0;
+  const auto mid = interpolate(truth, 0.5);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_NEAR(mid->q.angularDistance(poseAt(0, 0, 0, 0, 45).q), 0, 1e-12);
+}
+
 // Nearest stamps within t_max_diff, one to one (a second estimate near the same ref is dropped).
 TEST(EvalAssociate, NearestStampWithinMaxDiff) {
   const PoseTrajectory ref = {poseAt(0, 0, 0, 0), poseAt(1, 0, 0, 0), poseAt(2, 0, 0, 0),

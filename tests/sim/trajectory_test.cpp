@@ -107,8 +107,7 @@ TEST(Trajectory, BadInputIsRefusedWithItsPlace) {
   const std::string one = writeFile("one.tum", "1.0 0 0 0 0 0 0 1\n");
   EXPECT_NE(message([&] { readTumTrajectory(one); }).find("at least two poses"), std::string::npos);
   const std::string back = writeFile("back.tum", "2.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0 1\n");
-  EXPECT_NE(message([&] { readTumTrajectory(back); }).find("pose 2 is not later"),
-            std::string::npos);
+  EXPECT_NE(message([&] { readTumTrajectory(back); }).find("back.tum:2"), std::string::npos);
   const std::string short_line = writeFile("short.tum", "1.0 0 0 0 0 0 0 1\n2.0 0 0\n");
   EXPECT_NE(message([&] { readTumTrajectory(short_line); }).find("short.tum:2"), std::string::npos);
   const std::string no_yaw =
