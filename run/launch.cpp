@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -48,8 +50,19 @@ std::string selfDirectory() {
 struct ChannelHealth {
   std::int64_t total = 0;
   std::int64_t window = 0;
+  // Rate the scenario should produce, Hz of sim time; 0 when not known.
   double expected_hz = 0.0;
+  std::optional<std::int64_t> first_utime, last_utime;
   int vo_status = -1;
+
+  // Messages missing so far: what the sim-time span at expected_hz holds
+  // minus what arrived (the messages carry their sim time).
+  std::int64_t missing() const {
+    if (expected_hz <= 0.0 || !first_utime) return 0;
+    const double span_s = core::secondsFromUtime(*last_utime - *first_utime);
+    const auto expected = static_cast<std::int64_t>(std::floor(span_s * expected_hz + 1e-6)) + 1;
+    return std::max<std::int64_t>(0, expected - total);
+  }
 };
 
 }  // namespace
@@ -114,6 +127,10 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     ChannelHealth& health = channels[std::string(raw.channel)];
     ++health.total;
     ++health.window;
+    if (const auto utime = core::peekUtime(raw)) {
+      if (!health.first_utime) health.first_utime = *utime;
+      health.last_utime = std::max(*utime, health.last_utime.value_or(*utime));
+    }
     if (std::find(vo_channels.begin(), vo_channels.end(), raw.channel) != vo_channels.end()) {
       nadir::vo_estimate_t estimate;
       if (estimate.decode(raw.data, 0, static_cast<int>(raw.size)) > 0) {
@@ -202,8 +219,9 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
                         static_cast<double>(health.window) / window_s);
           out << line;
           if (health.expected_hz > 0.0) {
-            std::snprintf(line, sizeof(line), " (expected %.1f)",
-                          health.expected_hz * scenario.time.speed);
+            std::snprintf(line, sizeof(line), " (expected %.1f), %lld missing",
+                          health.expected_hz * scenario.time.speed,
+                          static_cast<long long>(health.missing()));
             out << line;
           }
           if (health.vo_status >= 0) {
@@ -230,7 +248,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     if (!clean && result == 0) result = 1;
   }
   out << "launch: messages received\n";
-  for (const auto& [name, health] : channels) out << "  " << name << ": " << health.total << "\n";
+  for (const auto& [name, health] : channels) {
+    out << "  " << name << ": " << health.total;
+    if (health.expected_hz > 0.0) out << " (" << health.missing() << " missing)";
+    out << "\n";
+  }
   out << "launch: recording " << recording.string() << "\n";
   return result;
 }
