@@ -100,6 +100,10 @@ void validateOptions(const EvalOptions& options) {
     throw EvalError("tracked_hold_periods must be > 0, got " +
                     formatShort(options.tracked_hold_periods));
   }
+  if (!(options.track_length_interval_s >= 0)) {
+    throw EvalError("track_length_interval_s must be >= 0 s, got " +
+                    formatShort(options.track_length_interval_s));
+  }
   if (!(options.truth_max_gap_s > 0)) {
     throw EvalError("truth_max_gap_s must be > 0 s, got " + formatShort(options.truth_max_gap_s));
   }

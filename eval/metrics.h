@@ -47,6 +47,11 @@ struct EvalOptions {
   // Run metrics: an estimate is not compared if the truth samples around it are
   // further apart than this (a hole in a damaged log), s.
   double truth_max_gap_s = 0.5;
+  // Run metrics: path lengths (seed 000's track length) sum the distances
+  // between samples at least this far apart in time (and each segment's last),
+  // s; 0 uses every estimate. Sampled finely, a pixel's jitter in a 200 Hz
+  // estimate adds to its path what the flight did not fly.
+  double track_length_interval_s = 1.0;
 };
 // Throws EvalError naming the bad option (unknown align or unit, delta <= 0,
 // a fractional delta in frames, t_max_diff_s < 0, ...).

@@ -270,9 +270,12 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
   m.track_length_m = 0;
   m.truth_track_length_m = 0;
   for (const auto& [begin, end] : segments) {
+    std::size_t last = begin;
     for (std::size_t i = begin + 1; i < end; ++i) {
-      m.track_length_m += (est[i].p_m - est[i - 1].p_m).norm();
-      m.truth_track_length_m += (ref[i].p_m - ref[i - 1].p_m).norm();
+      if (i + 1 != end && ref[i].t_s - ref[last].t_s < options.track_length_interval_s) continue;
+      m.track_length_m += (est[i].p_m - est[last].p_m).norm();
+      m.truth_track_length_m += (ref[i].p_m - ref[last].p_m).norm();
+      last = i;
     }
   }
   m.track_length_diff_pct =
@@ -439,7 +442,8 @@ void writeMetricsJson(const std::string& path, const RunMetrics& metrics,
                       {"rpe_delta", options.rpe_delta},
                       {"rpe_delta_unit", options.rpe_delta_unit},
                       {"tracked_hold_periods", options.tracked_hold_periods},
-                      {"truth_max_gap_s", options.truth_max_gap_s}};
+                      {"truth_max_gap_s", options.truth_max_gap_s},
+                      {"track_length_interval_s", options.track_length_interval_s}};
   Json sources = Json::object();
   for (const auto& [name, source] : metrics.sources) sources[name] = sourceJson(source);
   j["sources"] = sources;
@@ -476,6 +480,7 @@ RunMetrics readMetricsJson(const std::string& path, EvalOptions* options) {
     options->rpe_delta = r.number(o, "rpe_delta", "options");
     options->rpe_delta_unit = r.text(o, "rpe_delta_unit", "options");
     options->tracked_hold_periods = r.number(o, "tracked_hold_periods", "options");
+    options->track_length_interval_s = r.number(o, "track_length_interval_s", "options");
     options->truth_max_gap_s = r.number(o, "truth_max_gap_s", "options");
   }
   const Json& sources = r.at(j, "sources", "top level");

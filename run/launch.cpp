@@ -114,7 +114,16 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
                       nodeLog("camera"));
   ChildProcess simulator("nadir-sim", withScenario({programPath(bin_dir, "nadir-sim")}),
                          nodeLog("sim"));
-  std::vector<ChildProcess*> nodes = {&logger, &camera, &simulator};
+  // The VO nodes the scenario names.
+  ChildProcess ppa("nadir-ppa",
+                   withScenario({scenario.ppa.enabled ? programPath(bin_dir, "nadir-ppa")
+                                                      : std::string("nadir-ppa")}),
+                   nodeLog("ppa"));
+  std::vector<ChildProcess*> listeners = {&camera};
+  if (scenario.ppa.enabled) listeners.push_back(&ppa);
+  std::vector<ChildProcess*> nodes = {&logger};
+  nodes.insert(nodes.end(), listeners.begin(), listeners.end());
+  nodes.push_back(&simulator);
 
   // Health: what arrives on the bus, against what the scenario should produce.
   auto bus = core::openBus(scenario.bus);
@@ -152,21 +161,24 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   };
   try {
     logger.start();
-    camera.start();
-    // The camera builds its world and GL context before it listens; wait for it.
+    for (ChildProcess* node : listeners) node->start();
+    // Each node sets up (the camera its world and GL context) before it listens
+    // and says "bus: ..."; the simulator starts when all have.
     const auto ready_deadline = Clock::now() + std::chrono::seconds(120);
-    while (!fileContains(camera.logPath(), "bus: ")) {
-      if (!camera.running()) {
-        failed(camera);
-        stopAll();
-        return result;
+    for (ChildProcess* node : listeners) {
+      while (!fileContains(node->logPath(), "bus: ")) {
+        if (!node->running()) {
+          failed(*node);
+          stopAll();
+          return result;
+        }
+        if (stop || Clock::now() > ready_deadline) {
+          out << "launch: " << (stop ? "stopped" : node->name() + " not ready after 120 s") << "\n";
+          stopAll();
+          return stop ? 130 : 1;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
-      if (stop || Clock::now() > ready_deadline) {
-        out << "launch: " << (stop ? "stopped" : "nadir-camera not ready after 120 s") << "\n";
-        stopAll();
-        return stop ? 130 : 1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     simulator.start();

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -10,12 +12,16 @@
 #include "core/clock.h"
 #include "core/lcm_log.h"
 #include "eval/trajectory.h"
+#include "nadir/target_detection_t.hpp"
 #include "nodes/camera/camera_messages.h"
 #include "nodes/camera/camera_node.h"
+#include "nodes/ppa/ppa_node.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
+#include "run/target_passes.h"
 #include "run/track_plot.h"
 #include "scenario/scenario.h"
+#include "terrain/world.h"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -80,6 +86,18 @@ RunResult runScenario(const RunOptions& options,
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
+  // The VO nodes the scenario names, on the same bus.
+  std::optional<ppa::PpaNode> ppa_node;
+  std::vector<std::pair<double, bool>> detector_frames;
+  std::vector<core::Subscription> detector_subscription;
+  const std::vector<Eigen::Vector2d> targets_ne_m = scenario::knownTargets(scenario, frame);
+  if (scenario.ppa.enabled) {
+    ppa_node.emplace(*bus, scenario.ppa, targets_ne_m);
+    detector_subscription.push_back(core::subscribe<nadir::target_detection_t>(
+        *bus, scenario.ppa.target_channel, [&detector_frames](const nadir::target_detection_t& d) {
+          detector_frames.emplace_back(core::secondsFromUtime(d.utime), d.detected);
+        }));
+  }
 
   const auto wall_start = std::chrono::steady_clock::now();
   auto last_report = wall_start;
@@ -133,6 +151,22 @@ RunResult runScenario(const RunOptions& options,
     eval::writeTum(result.tum_paths.back(), tracked);
   }
   result.table = eval::formatResultsTable(result.metrics);
+  if (scenario.ppa.enabled && scenario.ppa.target_extraction && !targets_ne_m.empty() &&
+      recorded.sources.count("ppa") != 0) {
+    TargetPassInput passes;
+    passes.truth = recorded.truth;
+    for (const eval::StampedPose& pose : recorded.truth) {
+      passes.truth_height_m.push_back(terrain::heightAboveGround_m(
+          *camera.scene().built.world, pose.p_m.x(), pose.p_m.y(), pose.p_m.z()));
+    }
+    passes.estimates = recorded.sources.at("ppa");
+    passes.detector_frames = detector_frames;
+    passes.targets_ne_m = targets_ne_m;
+    passes.hfov_rad = scenario.camera.camera.hfov_deg * std::numbers::pi / 180.0;
+    result.target_passes = targetPasses(passes);
+    result.table += "\n" + formatTargetPasses(result.target_passes);
+    std::ofstream(out / "target_passes.csv") << targetPassesCsv(result.target_passes);
+  }
   return result;
 }
 

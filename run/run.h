@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "eval/run_metrics.h"
+#include "run/target_passes.h"
 
 namespace nadir::run {
 
@@ -45,6 +46,8 @@ struct RunResult {
   std::vector<std::string> picture_paths;
   eval::RunMetrics metrics;
   RunProgress totals;
+  // Passes over the scenario's known targets, with the PPA's detections and errors.
+  std::vector<TargetPass> target_passes;
   std::string table;
 };
 

@@ -33,6 +33,7 @@ void ScenarioParams::visit(core::ParamVisitor& v) {
   core::visitGroupMap(v, "targets", "ground targets by name", targets);
   core::visitGroup(v, "tiles", "terrain tiles and levels of detail", tiles);
   core::visitGroup(v, "renderer", "terrain drawing", renderer);
+  core::visitGroup(v, "ppa", "the emulated SCAMP-5 vision sensor (nadir-ppa)", ppa);
   core::visitGroup(v, "time", "how sim time runs", time);
   core::visitGroup(v, "bus", "where the streams go", bus);
 }
@@ -53,6 +54,28 @@ camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario) {
   params.cameras = scenario.allCameras();
   params.targets = scenario.targets;
   return params;
+}
+
+core::Geodetic scenarioOrigin(const ScenarioParams& scenario) {
+  if (scenario.world.kind == "files" && scenario.world.origin_at_dem_centre) {
+    return terrain::makeWorld(scenario.world).origin;
+  }
+  return core::geodeticFromDegrees(scenario.world.origin_lat_deg, scenario.world.origin_lon_deg,
+                                   scenario.world.origin_alt_m);
+}
+
+std::vector<Eigen::Vector2d> knownTargets(const ScenarioParams& scenario,
+                                          const core::LocalNedFrame& frame) {
+  std::vector<terrain::GroundTarget> targets;
+  for (const auto& [name, target] : scenario.targets) {
+    if (target.kind == "concentric") targets.push_back(target);
+  }
+  terrain::resolveGeodeticTargets(targets, frame);
+  std::vector<Eigen::Vector2d> positions;
+  for (const terrain::GroundTarget& target : targets) {
+    positions.emplace_back(target.north_m, target.east_m);
+  }
+  return positions;
 }
 
 std::string scenarioDirectory() {

@@ -10,10 +10,13 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/bus.h"
 #include "core/params.h"
 #include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
+#include "nodes/ppa/ppa_node_params.h"
 #include "nodes/sim/sim_params.h"
 #include "render/terrain_renderer.h"
 #include "terrain/targets.h"
@@ -42,6 +45,8 @@ struct ScenarioParams {
   std::map<std::string, terrain::GroundTarget> targets;
   terrain::TileParams tiles;
   render::TerrainRendererParams renderer;
+  // The VO nodes: the emulated SCAMP-5 vision sensor.
+  ppa::PpaNodeParams ppa;
   TimeParams time;
   core::BusParams bus;
 
@@ -53,6 +58,14 @@ struct ScenarioParams {
 // What the camera node needs from a scenario: its bus, the truth channel,
 // the world, tiles, renderer, cameras and targets.
 camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario);
+
+// The world frame's geodetic origin (reads the DEM only when the origin is its centre).
+core::Geodetic scenarioOrigin(const ScenarioParams& scenario);
+
+// North and east of the scenario's concentric targets (the known targets a
+// VO node may correct its position with), geodetic ones resolved in frame.
+std::vector<Eigen::Vector2d> knownTargets(const ScenarioParams& scenario,
+                                          const core::LocalNedFrame& frame);
 
 // The folder of the built-in scenarios: $NADIR_SCENARIO_DIR if set, else the
 // project's scenarios/ folder.

@@ -244,6 +244,10 @@ void MultirotorParams::visit(core::ParamVisitor& v) {
           {.doc = "acceleration and braking, m/s^2", .min = 0.1, .max = 20});
   v.field("yaw_rate_dps", &yaw_rate_dps,
           {.doc = "yaw rate when turning, deg/s", .min = 1, .max = 720});
+  v.field("max_tilt_rate_dps", &max_tilt_rate_dps,
+          {.doc = "fastest roll or pitch change of the attitude controller, deg/s",
+           .min = 1,
+           .max = 2000});
   v.field("yaw_at_corners", &yaw_at_corners,
           {.doc = "stop and turn to face each new leg (else keep the start heading)"});
 }
@@ -304,8 +308,12 @@ void Multirotor::step() {
   const Eigen::Vector3d& a = state_.a_ned_mps2;
   const double forward = std::cos(yaw_rad_) * a.x() + std::sin(yaw_rad_) * a.y();
   const double right = -std::sin(yaw_rad_) * a.x() + std::cos(yaw_rad_) * a.y();
-  const double pitch = -std::atan2(forward, kGravity_mps2 - a.z());
-  const double roll = std::atan2(right * std::cos(pitch), kGravity_mps2 - a.z());
+  const double pitch_command = -std::atan2(forward, kGravity_mps2 - a.z());
+  const double roll_command = std::atan2(right * std::cos(pitch_command), kGravity_mps2 - a.z());
+  const double max_tilt_step = params_.max_tilt_rate_dps * kDeg * dt;
+  pitch_rad_ += std::clamp(pitch_command - pitch_rad_, -max_tilt_step, max_tilt_step);
+  roll_rad_ += std::clamp(roll_command - roll_rad_, -max_tilt_step, max_tilt_step);
+  const double pitch = pitch_rad_, roll = roll_rad_;
   const core::RollPitchYaw rpy{roll, pitch, yaw_rad_};
   state_.q_world_body = core::quaternionFromRpy(rpy);
   state_.omega_body_rps = bodyRates(rpy, (roll - previous_rpy.roll_rad) / dt,

@@ -97,6 +97,9 @@ struct MultirotorParams {
   double speed_mps = 3.0;
   double acceleration_mps2 = 1.5;
   double yaw_rate_dps = 45.0;
+  // The attitude controller tilts the vehicle towards what the acceleration
+  // needs no faster than this, deg/s (so the tilt does not jump when braking starts).
+  double max_tilt_rate_dps = 60.0;
   bool yaw_at_corners = true;
   // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
@@ -123,6 +126,8 @@ class Multirotor {
   VehicleState state_;
   double yaw_rad_ = 0.0;
   double speed_mps_ = 0.0;
+  double roll_rad_ = 0.0;
+  double pitch_rad_ = 0.0;
 };
 
 // Ground rover: kinematic bicycle model (rear-axle reference point) on flat

@@ -90,6 +90,28 @@ TEST(EvalRunMetrics, SilentHoleHoldsThreePeriods) {
 }
 
 // Seed 000 on three sides of a 100 m square against the same path scaled 0.9 about its start:
+// Path lengths sample every track_length_interval_s: a 200 Hz estimate that wobbles 1 cm
+// across a 10 m straight flight adds 200 x 2 cm of wobble at every estimate, none at 1 s.
+TEST(EvalRunMetrics, TrackLengthSamplesAtTheInterval) {
+  PoseTrajectory truth;
+  std::vector<SourceEstimate> estimates;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.005 * i;
+    truth.push_back({t, Eigen::Vector3d(10.0 * t, 0, 0), Eigen::Quaterniond::Identity()});
+    const double wobble = (i % 2 == 0 ? 0.01 : -0.01);
+    estimates.push_back(SourceEstimate{t, SourceEstimate::kTracking,
+                                       Eigen::Vector3d(10.0 * t, wobble, 0),
+                                       Eigen::Quaterniond::Identity()});
+  }
+  EvalOptions every;
+  every.track_length_interval_s = 0.0;
+  // Each 5 ms step: 0.05 m along, 0.02 m across: sqrt(0.05^2 + 0.02^2) = 0.053852 m.
+  EXPECT_NEAR(evaluateSource(truth, estimates, every).track_length_m, 200 * 0.0538516, 1e-4);
+  // At 1 s: the first and the last estimate, 10 m apart (both wobble +1 cm).
+  const SourceMetrics sampled = evaluateSource(truth, estimates, EvalOptions{});
+  EXPECT_NEAR(sampled.track_length_m, 10.0, 1e-9);
+  EXPECT_NEAR(sampled.truth_track_length_m, 10.0, 1e-9);
+}
 // length -10 %, end point 10 m = 3.333 % of 300 m, MAE (0 + 10 + 14.142 + 10) / 4.
 TEST(EvalRunMetrics, Seed000SquareVersusScaledSquare) {
   const Eigen::Vector3d corners[4] = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}, {0, 100, 0}};

@@ -110,6 +110,44 @@ TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
   EXPECT_EQ(readFile(json), readFile(result.metrics_path));
 }
 
+// Seed 000's flight, one lap, the emulated SCAMP-5 without target correction: within the
+// issue's bounds (mean absolute error <= 1 m, end point <= 0.5 % of the track).
+TEST(Run, PpaOdometryOnOneLapOfTheRectangle) {
+  RunOptions options;
+  options.scenario = "scamp-rectangle";
+  options.out_dir = tempDir("ppa_lap");
+  options.overrides = {"route.repeat=1", "ppa.host.target_gate_m=0"};
+  options.record_images = false;
+  const RunResult result = runScenario(options);
+  ASSERT_EQ(result.metrics.sources.count("ppa"), 1u);
+  const eval::SourceMetrics& ppa = result.metrics.sources.at("ppa");
+  EXPECT_TRUE(ppa.initialised);
+  EXPECT_GT(ppa.tracked_pct, 99.0);
+  EXPECT_NEAR(ppa.truth_track_length_m, 150.0, 3.0);
+  EXPECT_LT(ppa.mean_abs_error_m, 1.0);
+  EXPECT_LT(ppa.end_point_pct, 0.5);
+  EXPECT_NEAR(ppa.rate_hz, 200.0, 1.0);
+}
+
+// With target correction, the target by the start corner is found on every pass over it
+// and leaves the position within 0.3 m.
+TEST(Run, PpaTargetCorrectionOnEveryPass) {
+  RunOptions options;
+  options.scenario = "scamp-rectangle";
+  options.out_dir = tempDir("ppa_target");
+  options.overrides = {"route.repeat=1"};
+  options.record_images = false;
+  const RunResult result = runScenario(options);
+  // One lap passes the target as it starts and as it ends.
+  ASSERT_EQ(result.target_passes.size(), 2u);
+  for (const TargetPass& pass : result.target_passes) {
+    EXPECT_GT(pass.frames, 100);
+    EXPECT_EQ(pass.detections, pass.frames);
+    ASSERT_TRUE(pass.error_after_m.has_value());
+    EXPECT_LT(*pass.error_after_m, 0.3);
+  }
+}
+
 // A sweep file's grid: every combination, last axis fastest, named by its values.
 TEST(Sweep, PlansTheGrid) {
   const std::string dir = tempDir("sweep_plan");

@@ -98,10 +98,10 @@ TEST(SimNode, BatchRunWritesTheStreamsToALog) {
   const LogContents contents = readLog(log);
   EXPECT_EQ(contents.counts.at("POSE_TRUTH"), 801);
   EXPECT_EQ(contents.counts.at("IMU"), 801);    // 400 Hz in this scenario
-  EXPECT_EQ(contents.counts.at("RANGE"), 201);  // 100 Hz
+  EXPECT_EQ(contents.counts.at("RANGE"), 401);  // 200 Hz
   EXPECT_EQ(contents.counts.at("GPS"), 11);     // 5 Hz
   EXPECT_EQ(contents.counts.at("BARO"), 101);   // 50 Hz
-  EXPECT_EQ(contents.counts.at("NAV_POSITION"), 101);
+  EXPECT_EQ(contents.counts.at("NAV_POSITION"), 401);  // 200 Hz
   ASSERT_EQ(contents.poses.size(), 801u);
   for (std::size_t i = 0; i < contents.poses.size(); ++i) {
     ASSERT_EQ(contents.poses[i].utime, static_cast<std::int64_t>(i) * 2500);

@@ -182,7 +182,8 @@ TEST(Multirotor, TiltsWithAcceleration) {
   MultirotorParams params;
   params.acceleration_mps2 = 2.0;
   Multirotor drone(params, {0, 0, -10}, 0.0, {Eigen::Vector3d(100, 0, -10)});
-  for (int i = 0; i < 100; ++i) drone.step();
+  // 11.5 deg at 60 deg/s takes 0.19 s; after 0.5 s the vehicle is still accelerating.
+  for (int i = 0; i < 200; ++i) drone.step();
   const core::RollPitchYaw rpy = core::rpyFromQuaternion(drone.state().q_world_body);
   // 2 m/s^2 forward: pitch = -atan(2 / g) = -11.53 deg.
   EXPECT_NEAR(rpy.pitch_rad, -std::atan(2.0 / 9.80665), 1e-9);
@@ -204,6 +205,26 @@ TEST(Multirotor, TiltStaysWithinTheAccelerationLimit) {
   }
   EXPECT_LE(max_tilt, std::atan(1.5 / 9.80665) + 1e-9);
   EXPECT_GT(max_tilt, std::atan(1.5 / 9.80665) - 1e-3);  // braking does reach the limit
+}
+
+// The tilt changes no faster than the attitude controller's rate, even when braking starts.
+TEST(Multirotor, TiltRateIsLimited) {
+  MultirotorParams params;
+  params.max_tilt_rate_dps = 60.0;
+  Multirotor drone(params, {0, 0, -5}, 0.0,
+                   {Eigen::Vector3d(20, 0, -5), Eigen::Vector3d(20, 20, -5)});
+  Eigen::Vector3d previous_down = drone.state().q_world_body * Eigen::Vector3d::UnitZ();
+  double max_rate = 0.0;
+  while (!drone.finished()) {
+    drone.step();
+    const Eigen::Vector3d down = drone.state().q_world_body * Eigen::Vector3d::UnitZ();
+    max_rate = std::max(max_rate,
+                        std::acos(std::clamp(down.dot(previous_down), -1.0, 1.0)) / params.step_s);
+    previous_down = down;
+  }
+  // Roll and pitch each at most 60 deg/s: the body axis swings at most sqrt(2) x that.
+  EXPECT_LE(max_rate, std::sqrt(2.0) * 60.0 * kDeg * 1.001);
+  EXPECT_GT(max_rate, 30.0 * kDeg);
 }
 
 // The rover's turn at full steering has radius wheelbase / tan(steer): 0.3 m at

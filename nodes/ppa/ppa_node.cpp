@@ -1,0 +1,198 @@
+#include "nodes/ppa/ppa_node.h"
+
+#include <opencv2/core.hpp>
+
+#include "core/frames.h"
+#include "nadir/ppa_odometry_t.hpp"
+#include "nadir/target_detection_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+#include "nodes/camera/camera_messages.h"
+
+namespace nadir::ppa {
+namespace {
+
+constexpr std::size_t kAttitudeHistory = 64;
+
+void visitArray(core::ParamVisitor& v, PpaParams& array) {
+  v.field("analog_noise_sigma", &array.analog_noise_sigma,
+          {.doc = "noise of each analog write, counts; 0 = none", .min = 0, .max = 50});
+  std::int64_t seed = static_cast<std::int64_t>(array.noise_seed);
+  v.field("noise_seed", &seed, {.doc = "seed of the analog noise", .min = 0});
+  array.noise_seed = static_cast<std::uint64_t>(seed);
+  v.field(
+      "pix_response", &array.pix_response,
+      {.doc = "PIX response: log (high dynamic range) or linear", .choices = {"log", "linear"}});
+  v.field("pix_gain", &array.pix_gain, {.doc = "gain on the light", .min = 0.001, .max = 1000});
+}
+
+}  // namespace
+
+void PpaNodeParams::visit(core::ParamVisitor& v) {
+  v.field("enabled", &enabled, {.doc = "run the PPA emulator in this scenario"});
+  v.field("image_channel", &image_channel, {.doc = "the PPA camera's 256x256 gray images"});
+  v.field("info_channel", &info_channel, {.doc = "its camera_info_t (the lens)"});
+  v.field("range_channel", &range_channel, {.doc = "range_t: height above ground"});
+  v.field("attitude_channel", &attitude_channel,
+          {.doc = "attitude_t: the flight controller's attitude"});
+  v.field("truth_channel", &truth_channel, {.doc = "pose_t read once: the start pose"});
+  v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
+  v.field("odometry_channel", &odometry_channel, {.doc = "ppa_odometry_t out"});
+  v.field("target_channel", &target_channel, {.doc = "target_detection_t out"});
+  v.field("target_extraction", &target_extraction,
+          {.doc = "run target extraction after the odometry on every frame"});
+  v.field("chip_instruction_rate_hz", &chip_instruction_rate_hz,
+          {.doc = "emulated chip's instruction rate, Hz (processing time = instructions / rate)",
+           .min = 1e3,
+           .max = 1e12});
+  v.group("array", "the emulated SCAMP-5 array",
+          [this](core::ParamVisitor& inner) { visitArray(inner, array); });
+  core::visitGroup(v, "vo", "on-sensor visual odometry", vo);
+  core::visitGroup(v, "target", "on-sensor target extraction", target);
+  core::visitGroup(v, "host", "pixels to metres, integration, target correction", host);
+}
+
+PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
+                 std::vector<Eigen::Vector2d> targets_ne_m)
+    : bus_(bus),
+      params_(params),
+      array_(params.array),
+      vo_(params.vo),
+      extractor_(params.target),
+      host_(params.host,
+            PpaCamera::fromFov(kWidth, kHeight, params.host.hfov_deg * std::numbers::pi / 180.0,
+                               core::rotationBodyFromDownCamera()),
+            std::move(targets_ne_m)) {
+  subscriptions_.push_back(core::subscribe<nadir::range_t>(
+      bus_, params_.range_channel, [this](const nadir::range_t& range) { range_ = range; }));
+  subscriptions_.push_back(core::subscribe<nadir::attitude_t>(
+      bus_, params_.attitude_channel, [this](const nadir::attitude_t& attitude) {
+        attitudes_.push_back(attitude);
+        if (attitudes_.size() > kAttitudeHistory) attitudes_.pop_front();
+      }));
+  subscriptions_.push_back(core::subscribe<nadir::pose_t>(bus_, params_.truth_channel,
+                                                          [this](const nadir::pose_t& pose) {
+                                                            if (!first_truth_) first_truth_ = pose;
+                                                          }));
+  subscriptions_.push_back(core::subscribe<nadir::camera_info_t>(
+      bus_, params_.info_channel, [this](const nadir::camera_info_t& info) {
+        PpaCamera camera;
+        camera.width = info.width;
+        camera.height = info.height;
+        camera.fx = info.fx;
+        camera.fy = info.fy;
+        camera.cx = info.cx;
+        camera.cy = info.cy;
+        camera.R_body_cam = core::quaternionFromWire(info.orientation_body_cam).toRotationMatrix();
+        host_.setCamera(camera);
+      }));
+  subscriptions_.push_back(core::subscribe<nadir::image_t>(
+      bus_, params_.image_channel, [this](const nadir::image_t& image) { onImage(image); }));
+}
+
+double PpaNode::meanInstructionsPerFrame() const {
+  return frames_ == 0 ? 0.0 : static_cast<double>(instructions_) / static_cast<double>(frames_);
+}
+
+void PpaNode::drop(const std::string& reason) {
+  if (dropped_images_++ == 0) first_drop_reason_ = reason;
+}
+
+void PpaNode::onImage(const nadir::image_t& image) {
+  cv::Mat gray;
+  try {
+    gray = camera::imageFromMessage(image);
+  } catch (const std::exception& error) {
+    drop(error.what());
+    return;
+  }
+  if (gray.type() != CV_8UC1 || gray.cols != kWidth || gray.rows != kHeight) {
+    drop("the PPA needs 256x256 gray images, got " + std::to_string(gray.cols) + "x" +
+         std::to_string(gray.rows) + " with " + std::to_string(gray.channels()) + " channel(s)");
+    return;
+  }
+  if (!gray.isContinuous()) gray = gray.clone();
+  if (!host_.initialised() && first_truth_ && first_truth_->utime <= image.utime) {
+    host_.initialise(
+        Eigen::Vector3d(first_truth_->pos[0], first_truth_->pos[1], first_truth_->pos[2]));
+  }
+
+  array_.setLight(gray.ptr<std::uint8_t>());
+  const VisualOdometryResult vo = vo_.processFrame(array_);
+  std::optional<TargetExtractionResult> target;
+  if (params_.target_extraction) target = extractor_.processFrame(array_);
+  // Each program counts its instructions, the controller's loads among them.
+  const std::uint64_t instructions = vo.instructions + (target ? target->instructions : 0);
+  instructions_ += instructions;
+  ++frames_;
+
+  // The attitude at (or just before) the frame.
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
+  for (auto it = attitudes_.rbegin(); it != attitudes_.rend(); ++it) {
+    if (it->utime <= image.utime) {
+      q_world_body = core::quaternionFromWire(it->orientation);
+      break;
+    }
+  }
+  PpaHostInput input;
+  input.utime = image.utime;
+  input.alignment = {vo.translation_x_px, vo.translation_y_px, vo.rotation_rad,       vo.scale,
+                     vo.strength,         vo.new_keyframe,     vo.keyframe_edge_count};
+  if (range_ && range_->status == nadir::range_t::STATUS_VALID) input.range_m = range_->range_m;
+  input.q_world_body = q_world_body;
+  // Only a target wholly in view corrects the position: a box cut by the
+  // image's border has a shifted centre.
+  constexpr int kBorderMarginPx = 2;
+  if (target && target->detected && target->box.x_min >= kBorderMarginPx &&
+      target->box.y_min >= kBorderMarginPx && target->box.x_max < kWidth - kBorderMarginPx &&
+      target->box.y_max < kHeight - kBorderMarginPx) {
+    input.target_center_px = Eigen::Vector2d(target->center_x_px, target->center_y_px);
+  }
+  const PpaHostOutput out = host_.update(input);
+
+  nadir::vo_estimate_t estimate{};
+  estimate.utime = image.utime;
+  estimate.source = "ppa";
+  estimate.status = out.status == PpaStatus::kTracking ? nadir::vo_estimate_t::STATUS_TRACKING
+                    : out.status == PpaStatus::kLost   ? nadir::vo_estimate_t::STATUS_LOST
+                                                       : nadir::vo_estimate_t::STATUS_INITIALIZING;
+  estimate.pose.utime = image.utime;
+  for (int i = 0; i < 3; ++i) estimate.pose.pos[i] = out.p_ned_m[i];
+  core::quaternionToWire(out.q_world_body, estimate.pose.orientation);
+  estimate.num_features = vo.keyframe_edge_count;
+  estimate.num_resets = 0;
+  estimate.processing_time_s = static_cast<double>(instructions) / params_.chip_instruction_rate_hz;
+  core::publish(bus_, params_.pose_channel, estimate);
+
+  nadir::ppa_odometry_t odometry{};
+  odometry.utime = image.utime;
+  odometry.frame_index = static_cast<std::int64_t>(frames_ - 1);
+  odometry.translation_x_px = vo.translation_x_px;
+  odometry.translation_y_px = vo.translation_y_px;
+  odometry.rotation_rad = vo.rotation_rad;
+  odometry.scale = vo.scale;
+  odometry.strength = vo.strength;
+  odometry.new_keyframe = vo.new_keyframe;
+  odometry.keyframe_edge_count = vo.keyframe_edge_count;
+  odometry.instruction_count = static_cast<std::int64_t>(instructions);
+  core::publish(bus_, params_.odometry_channel, odometry);
+
+  if (target) {
+    nadir::target_detection_t detection{};
+    detection.utime = image.utime;
+    detection.kind = nadir::target_detection_t::KIND_CONCENTRIC;
+    detection.detected = target->detected;
+    detection.num_boundaries = params_.target.boundaries;
+    if (target->detected) {
+      detection.x_min_px = target->box.x_min;
+      detection.y_min_px = target->box.y_min;
+      detection.x_max_px = target->box.x_max;
+      detection.y_max_px = target->box.y_max;
+      detection.center_x_px = target->center_x_px;
+      detection.center_y_px = target->center_y_px;
+    }
+    detection.num_points = 0;
+    core::publish(bus_, params_.target_channel, detection);
+  }
+}
+
+}  // namespace nadir::ppa

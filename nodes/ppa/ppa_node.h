@@ -1,0 +1,63 @@
+#pragma once
+// nadir-ppa's work on a bus, the same in the live node and in `nadir run`: the
+// PPA camera's frames go through the emulated chip (visual odometry, then
+// target extraction), the host turns the alignment into a position with the
+// rangefinder and the flight controller's attitude, and the node publishes
+// vo_estimate_t, ppa_odometry_t and target_detection_t. Bad messages are
+// dropped and counted.
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/bus.h"
+#include "nadir/attitude_t.hpp"
+#include "nadir/camera_info_t.hpp"
+#include "nadir/image_t.hpp"
+#include "nadir/pose_t.hpp"
+#include "nadir/range_t.hpp"
+#include "nodes/ppa/ppa_array.h"
+#include "nodes/ppa/ppa_host.h"
+#include "nodes/ppa/ppa_node_params.h"
+#include "nodes/ppa/target_extraction.h"
+#include "nodes/ppa/visual_odometry.h"
+
+namespace nadir::ppa {
+
+class PpaNode {
+ public:
+  // targets_ne_m: the known concentric targets (north, east) for position correction.
+  PpaNode(core::Bus& bus, const PpaNodeParams& params, std::vector<Eigen::Vector2d> targets_ne_m);
+
+  std::uint64_t frames() const { return frames_; }
+  std::uint64_t droppedImages() const { return dropped_images_; }
+  // The first dropped image's problem; empty if none.
+  const std::string& firstDropReason() const { return first_drop_reason_; }
+  // Mean emulated instructions per frame so far.
+  double meanInstructionsPerFrame() const;
+
+ private:
+  void onImage(const nadir::image_t& image);
+  void drop(const std::string& reason);
+
+  core::Bus& bus_;
+  PpaNodeParams params_;
+  Ppa array_;
+  VisualOdometry vo_;
+  TargetExtractor extractor_;
+  PpaHost host_;
+  std::optional<nadir::range_t> range_;
+  std::deque<nadir::attitude_t> attitudes_;
+  std::optional<nadir::pose_t> first_truth_;
+  std::uint64_t frames_ = 0;
+  std::uint64_t dropped_images_ = 0;
+  std::uint64_t instructions_ = 0;
+  std::string first_drop_reason_;
+  std::vector<core::Subscription> subscriptions_;
+};
+
+}  // namespace nadir::ppa

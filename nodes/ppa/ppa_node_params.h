@@ -1,0 +1,38 @@
+#pragma once
+// Everything nadir-ppa reads from its parameters (a scenario's `ppa` group).
+
+#include <string>
+
+#include "core/params.h"
+#include "nodes/ppa/ppa_array.h"
+#include "nodes/ppa/ppa_host.h"
+#include "nodes/ppa/target_extraction.h"
+#include "nodes/ppa/visual_odometry.h"
+
+namespace nadir::ppa {
+
+struct PpaNodeParams {
+  // In a scenario: run the PPA (nadir run composes it, nadir launch starts nadir-ppa).
+  bool enabled = false;
+  std::string image_channel = "CAMERA_PPA";
+  std::string info_channel = "CAMERA_PPA_INFO";
+  std::string range_channel = "RANGE";
+  // The flight controller's attitude (seed 000 used the vehicle's IMU attitude).
+  std::string attitude_channel = "NAV_ATTITUDE";
+  // Read once: the start pose the estimate is anchored to.
+  std::string truth_channel = "POSE_TRUTH";
+  std::string pose_channel = "POSE_PPA";
+  std::string odometry_channel = "PPA_ODOMETRY";
+  std::string target_channel = "PPA_TARGET";
+  bool target_extraction = true;
+  // The emulated chip's instruction rate, Hz: processing_time_s = instructions / rate.
+  double chip_instruction_rate_hz = 10e6;
+  PpaParams array;
+  VisualOdometryParams vo;
+  TargetExtractionParams target;
+  PpaHostParams host;
+
+  void visit(core::ParamVisitor& v);
+};
+
+}  // namespace nadir::ppa
