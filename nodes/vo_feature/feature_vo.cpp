@@ -1,0 +1,504 @@
+#include "nodes/vo_feature/feature_vo.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+namespace nadir::vo {
+namespace {
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto mid = values.begin() + static_cast<long>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+Eigen::Vector2d project(const cv::Matx33d& K, const Eigen::Vector3d& p_cam) {
+  return {K(0, 0) * p_cam.x() / p_cam.z() + K(0, 2), K(1, 1) * p_cam.y() / p_cam.z() + K(1, 2)};
+}
+
+BaIntrinsics baIntrinsics(const cv::Matx33d& K) { return {K(0, 0), K(1, 1), K(0, 2), K(1, 2)}; }
+
+double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+  return Eigen::AngleAxisd(R_a.transpose() * R_b).angle() / kRadPerDeg;
+}
+
+// The per-frame share of a motion spread over n frames (rotation angle and
+// translation divided by n; exact for a constant twist up to the coupling).
+Eigen::Isometry3d perFrame(const Eigen::Isometry3d& T, int n) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  const Eigen::AngleAxisd aa(T.linear());
+  out.linear() = Eigen::AngleAxisd(aa.angle() / n, aa.axis()).matrix();
+  out.translation() = T.translation() / n;
+  return out;
+}
+
+}  // namespace
+
+void FeatureVoParams::visit(core::ParamVisitor& v) {
+  core::visitGroup(v, "features", "ORB extraction", features);
+  core::visitGroup(v, "two_view", "two-view initialisation", two_view);
+  core::visitGroup(v, "ba", "local bundle adjustment", ba);
+  v.field("min_init_matches", &min_init_matches,
+          {.doc = "initialise only from at least this many matches", .min = 8, .max = 100000});
+  v.field("min_tracked_points", &min_tracked_points,
+          {.doc = "fewer PnP inliers than this: the frame is lost", .min = 6, .max = 100000});
+  v.field("keyframe_min_shared_ratio", &keyframe_min_shared_ratio,
+          {.doc = "new key-frame when the tracked share of the last key-frame's points is below",
+           .min = 0.0,
+           .max = 1.0});
+  v.field("keyframe_max_rotation_deg", &keyframe_max_rotation_deg,
+          {.doc = "new key-frame when the rotation since the last one exceeds this, deg",
+           .min = 0.1,
+           .max = 180.0});
+  v.field("local_window", &local_window,
+          {.doc = "key-frames in the local bundle adjustment", .min = 2, .max = 100});
+  v.field("ba_every_keyframes", &ba_every_keyframes,
+          {.doc = "local bundle adjustment every this many key-frames", .min = 1, .max = 1000});
+  v.field("max_hamming", &max_hamming,
+          {.doc = "largest Hamming distance of a match", .min = 1, .max = 256});
+  v.field("match_ratio", &match_ratio,
+          {.doc = "ratio test of the matching (>= 1 disables)", .min = 0.1, .max = 1.0});
+  v.field("track_radius_px", &track_radius_px,
+          {.doc = "tracking window around the predicted position, px", .min = 1.0, .max = 1e4});
+  v.field("track_wide_radius_px", &track_wide_radius_px,
+          {.doc = "the wider window of the retry, px", .min = 1.0, .max = 1e4});
+  v.field("pnp_reprojection_px", &pnp_reprojection_px,
+          {.doc = "PnP RANSAC inlier threshold, px", .min = 0.1, .max = 100.0});
+  v.field("lost_frames_before_reset", &lost_frames_before_reset,
+          {.doc = "consecutive lost frames before re-initialising", .min = 1, .max = 100000});
+  v.field("scale_tolerance", &scale_tolerance,
+          {.doc = "correct the scale when |map height / measured - 1| exceeds this",
+           .min = 0.0,
+           .max = 1.0});
+  v.field("scale_gain", &scale_gain,
+          {.doc = "share of the scale error corrected per key-frame", .min = 0.0, .max = 1.0});
+}
+
+FeatureVo::FeatureVo(const FeatureVoParams& params) : params_(params) {
+  FeatureVoParams copy = params;
+  core::validateParams([&copy](core::ParamVisitor& v) { copy.visit(v); }, "vo_feature feature_vo");
+  setStartPose(Eigen::Isometry3d::Identity());
+}
+
+void FeatureVo::setStartPose(const Eigen::Isometry3d& T_world_body) {
+  T_world_body_start_ = T_world_body;
+  start_pending_ = true;
+  resetMap();
+  status_ = VoStatus::kInitializing;
+}
+
+void FeatureVo::resetMap() {
+  reference_.reset();
+  reference_height_m_.reset();
+  points_.clear();
+  keyframes_.clear();
+  keyframes_since_ba_ = 0;
+}
+
+int FeatureVo::numMapPoints() const {
+  return static_cast<int>(
+      std::count_if(points_.begin(), points_.end(), [](const MapPoint& p) { return !p.bad; }));
+}
+
+Eigen::Isometry3d FeatureVo::predict(int steps) const {
+  Eigen::Isometry3d T = T_world_cam_last_;
+  for (int i = 0; i < steps; ++i) T = T * T_delta_;
+  return T;
+}
+
+VoFrameOutput FeatureVo::output(VoStatus status, const Eigen::Isometry3d& T_world_cam,
+                                const Eigen::Isometry3d& T_body_cam, int tracked,
+                                bool keyframe) const {
+  VoFrameOutput out;
+  out.status = status;
+  out.T_world_body = T_world_cam * T_body_cam.inverse();
+  out.tracked_points = tracked;
+  out.new_keyframe = keyframe;
+  out.resets = resets_;
+  return out;
+}
+
+VoFrameOutput FeatureVo::process(const VoFrameInput& in) {
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  T_body_cam.linear() = in.R_body_cam;
+  if (start_pending_) {
+    T_world_cam_last_ = T_world_body_start_ * T_body_cam;
+    T_delta_ = Eigen::Isometry3d::Identity();
+    frames_since_good_ = 0;
+    lost_count_ = 0;
+    start_pending_ = false;
+  }
+  ++frame_index_;
+  ++frames_since_good_;
+
+  Frame cur;
+  cur.features = extractOrb(in.gray, params_.features);
+  cur.point_of_feature.assign(cur.features.keypoints.size(), -1);
+
+  Eigen::Isometry3d T_pred = predict(frames_since_good_);
+  if (in.q_world_body_prior) T_pred.linear() = in.q_world_body_prior->matrix() * in.R_body_cam;
+
+  if (status_ == VoStatus::kInitializing) return initialise(cur, in, T_body_cam, T_pred);
+
+  if (!track(cur, in, T_pred)) {
+    ++lost_count_;
+    if (lost_count_ >= params_.lost_frames_before_reset) {
+      // Start again from this frame, anchored where the motion model puts it.
+      resetMap();
+      ++resets_;
+      status_ = VoStatus::kInitializing;
+      cur.T_world_cam = T_pred;
+      reference_ = std::move(cur);
+      reference_height_m_ = in.height_agl_m;
+      reference_frame_index_ = frame_index_;
+      return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
+    }
+    return output(VoStatus::kLost, T_pred, T_body_cam, 0, false);
+  }
+
+  int tracked = 0;
+  for (int id : cur.point_of_feature) tracked += id >= 0 ? 1 : 0;
+  if (frames_since_good_ == 1) T_delta_ = T_world_cam_last_.inverse() * cur.T_world_cam;
+  lost_count_ = 0;
+  status_ = VoStatus::kTracking;
+
+  // Key-frame decision: the share of the last key-frame's points still tracked, the rotation.
+  const Frame& last_kf = keyframes_.back();
+  std::vector<int> kf_ids;
+  for (int id : last_kf.point_of_feature)
+    if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad) kf_ids.push_back(id);
+  std::sort(kf_ids.begin(), kf_ids.end());
+  int shared = 0;
+  for (int id : cur.point_of_feature)
+    if (id >= 0 && std::binary_search(kf_ids.begin(), kf_ids.end(), id)) ++shared;
+  const double share =
+      kf_ids.empty() ? 0.0 : static_cast<double>(shared) / static_cast<double>(kf_ids.size());
+  const bool new_kf = share < params_.keyframe_min_shared_ratio ||
+                      rotationAngleDeg(last_kf.T_world_cam.linear(), cur.T_world_cam.linear()) >
+                          params_.keyframe_max_rotation_deg;
+  if (new_kf) {
+    addKeyframe(cur, in);
+    cur.T_world_cam = keyframes_.back().T_world_cam;
+  }
+  T_world_cam_last_ = cur.T_world_cam;
+  frames_since_good_ = 0;
+  return output(VoStatus::kTracking, cur.T_world_cam, T_body_cam, tracked, new_kf);
+}
+
+VoFrameOutput FeatureVo::initialise(Frame& cur, const VoFrameInput& in,
+                                    const Eigen::Isometry3d& T_body_cam,
+                                    const Eigen::Isometry3d& T_pred) {
+  const auto restart_here = [&]() {
+    cur.T_world_cam = T_pred;
+    reference_ = std::move(cur);
+    reference_height_m_ = in.height_agl_m;
+    reference_frame_index_ = frame_index_;
+    return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
+  };
+  if (!reference_) return restart_here();
+
+  Frame& ref = *reference_;
+  std::vector<cv::DMatch> matches = matchBruteForce(ref.features, cur.features, params_.max_hamming,
+                                                    static_cast<float>(params_.match_ratio));
+  matches = filterByOrientation(ref.features, cur.features, matches);
+  // Too few matches: the reference is out of view; the VO starts again from
+  // this frame (for the first start, still at the start pose).
+  if (static_cast<int>(matches.size()) < params_.min_init_matches) return restart_here();
+
+  std::vector<cv::Point2f> px1, px2;
+  for (const cv::DMatch& m : matches) {
+    px1.push_back(ref.features.keypoints[static_cast<std::size_t>(m.queryIdx)].pt);
+    px2.push_back(cur.features.keypoints[static_cast<std::size_t>(m.trainIdx)].pt);
+  }
+  const TwoViewResult r = initialiseTwoView(px1, px2, in.K, params_.two_view);
+  if (!r.ok) return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
+
+  // Metric scale: the reference camera's height over the ground from the map.
+  const Eigen::Vector3d down_in_ref =
+      ref.T_world_cam.linear().transpose() * Eigen::Vector3d::UnitZ();
+  std::vector<double> heights;
+  for (const Eigen::Vector3d& p : r.points_1) heights.push_back(p.dot(down_in_ref));
+  const double map_height = median(heights);
+  if (!(map_height > 0.0)) return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
+  const double scale = reference_height_m_ ? *reference_height_m_ / map_height : 1.0;
+
+  Eigen::Isometry3d T_cur_ref = Eigen::Isometry3d::Identity();
+  T_cur_ref.linear() = r.R_21;
+  T_cur_ref.translation() = scale * r.t_21;
+  cur.T_world_cam = ref.T_world_cam * T_cur_ref.inverse();
+  for (std::size_t j = 0; j < r.points_1.size(); ++j) {
+    const cv::DMatch& m = matches[static_cast<std::size_t>(r.inlier_match_index[j])];
+    MapPoint mp;
+    mp.p_world = ref.T_world_cam * (scale * r.points_1[j]);
+    mp.descriptor = cur.features.descriptors.row(m.trainIdx).clone();
+    const int id = static_cast<int>(points_.size());
+    points_.push_back(std::move(mp));
+    ref.point_of_feature[static_cast<std::size_t>(m.queryIdx)] = id;
+    cur.point_of_feature[static_cast<std::size_t>(m.trainIdx)] = id;
+  }
+  const int frames = std::max(1, frame_index_ - reference_frame_index_);
+  T_delta_ = perFrame(T_cur_ref.inverse(), frames);
+  T_world_cam_last_ = cur.T_world_cam;
+  frames_since_good_ = 0;
+  lost_count_ = 0;
+  keyframes_.push_back(std::move(ref));
+  keyframes_.push_back(cur);
+  reference_.reset();
+  status_ = VoStatus::kTracking;
+  return output(VoStatus::kTracking, cur.T_world_cam, T_body_cam,
+                static_cast<int>(r.points_1.size()), true);
+}
+
+bool FeatureVo::track(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred) {
+  if (trackWithRadius(cur, in, T_pred, params_.track_radius_px) >= params_.min_tracked_points)
+    return true;
+  std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
+  if (trackWithRadius(cur, in, T_pred, params_.track_wide_radius_px) >= params_.min_tracked_points)
+    return true;
+  std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
+  return false;
+}
+
+int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
+                               double radius_px) {
+  std::vector<int> ids;
+  for (const Frame& kf : keyframes_)
+    for (int id : kf.point_of_feature)
+      if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+
+  const Eigen::Isometry3d T_cam_world = T_pred.inverse();
+  const double w = in.gray.cols;
+  const double h = in.gray.rows;
+  Features local;
+  std::vector<cv::Point2f> predicted;
+  std::vector<int> local_ids;
+  std::vector<cv::Mat> rows;
+  for (int id : ids) {
+    const MapPoint& mp = points_[static_cast<std::size_t>(id)];
+    const Eigen::Vector3d p_cam = T_cam_world * mp.p_world;
+    if (p_cam.z() <= 0.0) continue;
+    const Eigen::Vector2d px = project(in.K, p_cam);
+    if (px.x() < -radius_px || px.y() < -radius_px || px.x() > w + radius_px ||
+        px.y() > h + radius_px)
+      continue;
+    local.keypoints.emplace_back(
+        cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y())), 31.0f);
+    predicted.push_back(local.keypoints.back().pt);
+    rows.push_back(mp.descriptor);
+    local_ids.push_back(id);
+  }
+  if (static_cast<int>(local_ids.size()) < params_.min_tracked_points) return 0;
+  cv::vconcat(rows, local.descriptors);
+  const std::vector<cv::DMatch> matches =
+      matchByWindow(local, cur.features, predicted, static_cast<float>(radius_px),
+                    params_.max_hamming, static_cast<float>(params_.match_ratio));
+  if (static_cast<int>(matches.size()) < params_.min_tracked_points) return 0;
+
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (const cv::DMatch& m : matches) {
+    const Eigen::Vector3d& p =
+        points_[static_cast<std::size_t>(local_ids[static_cast<std::size_t>(m.queryIdx)])].p_world;
+    object.emplace_back(p.x(), p.y(), p.z());
+    const cv::Point2f& px = cur.features.keypoints[static_cast<std::size_t>(m.trainIdx)].pt;
+    image.emplace_back(px.x, px.y);
+  }
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(object, image, cv::Mat(in.K), cv::noArray(), rvec, tvec, false,
+                                     200, static_cast<float>(params_.pnp_reprojection_px), 0.999,
+                                     inliers, cv::SOLVEPNP_AP3P);
+  if (!ok || static_cast<int>(inliers.size()) < params_.min_tracked_points) return 0;
+  cv::Mat R_cv;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Matrix3d R_cam_world;
+  cv::cv2eigen(R_cv, R_cam_world);
+  Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+  T_cw.linear() = R_cam_world;
+  T_cw.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+
+  // Motion-only bundle adjustment on the RANSAC inliers: the points stay fixed.
+  BaProblem problem;
+  problem.K = baIntrinsics(in.K);
+  problem.cameras.push_back({T_cw.inverse(), false});
+  for (int i : inliers) {
+    const cv::DMatch& m = matches[static_cast<std::size_t>(i)];
+    problem.points.push_back({Eigen::Vector3d(object[static_cast<std::size_t>(i)].x,
+                                              object[static_cast<std::size_t>(i)].y,
+                                              object[static_cast<std::size_t>(i)].z),
+                              true});
+    const cv::KeyPoint& kp = cur.features.keypoints[static_cast<std::size_t>(m.trainIdx)];
+    problem.observations.push_back(
+        {0, static_cast<int>(problem.points.size()) - 1, Eigen::Vector2d(kp.pt.x, kp.pt.y),
+         std::pow(static_cast<double>(params_.features.scale_factor), kp.octave)});
+  }
+  const BaResult result = bundleAdjust(problem, params_.ba);
+  int tracked = 0;
+  for (std::size_t k = 0; k < inliers.size(); ++k) {
+    if (result.outlier[k]) continue;
+    const cv::DMatch& m = matches[static_cast<std::size_t>(inliers[k])];
+    cur.point_of_feature[static_cast<std::size_t>(m.trainIdx)] =
+        local_ids[static_cast<std::size_t>(m.queryIdx)];
+    ++tracked;
+  }
+  cur.T_world_cam = problem.cameras[0].T_world_cam;
+  return tracked;
+}
+
+double FeatureVo::medianHeight(const Frame& kf) const {
+  std::vector<double> heights;
+  const Eigen::Vector3d c = kf.T_world_cam.translation();
+  for (int id : kf.point_of_feature)
+    if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad)
+      heights.push_back(points_[static_cast<std::size_t>(id)].p_world.z() - c.z());
+  return median(heights);
+}
+
+void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
+  Frame kf = cur;
+  triangulateWithPrevious(kf, keyframes_.back(), in.K);
+  keyframes_.push_back(std::move(kf));
+  while (static_cast<int>(keyframes_.size()) > params_.local_window) keyframes_.pop_front();
+  if (++keyframes_since_ba_ >= params_.ba_every_keyframes) {
+    localBundleAdjust(in.K);
+    keyframes_since_ba_ = 0;
+  }
+  if (!in.height_agl_m) return;
+  const Frame& newest = keyframes_.back();
+  const double map_height = medianHeight(newest);
+  if (!(map_height > 0.0)) return;
+  last_scale_ratio_ = map_height / *in.height_agl_m;
+  if (std::abs(last_scale_ratio_ - 1.0) <= params_.scale_tolerance) return;
+  // Scale the new key-frame's points about its centre: its pose stays, the
+  // motion measured from here on comes out closer to metric.
+  const double factor = 1.0 + params_.scale_gain * (1.0 / last_scale_ratio_ - 1.0);
+  const Eigen::Vector3d c = newest.T_world_cam.translation();
+  for (int id : newest.point_of_feature)
+    if (id >= 0) {
+      MapPoint& mp = points_[static_cast<std::size_t>(id)];
+      mp.p_world = c + factor * (mp.p_world - c);
+    }
+  T_delta_.translation() *= factor;
+}
+
+void FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K) {
+  const auto subset = [](const Frame& f, std::vector<int>& index) {
+    Features out;
+    std::vector<cv::Mat> rows;
+    for (std::size_t i = 0; i < f.point_of_feature.size(); ++i) {
+      if (f.point_of_feature[i] >= 0) continue;
+      index.push_back(static_cast<int>(i));
+      out.keypoints.push_back(f.features.keypoints[i]);
+      rows.push_back(f.features.descriptors.row(static_cast<int>(i)));
+    }
+    if (!rows.empty()) cv::vconcat(rows, out.descriptors);
+    return out;
+  };
+  std::vector<int> index_prev, index_new;
+  const Features a = subset(kf_prev, index_prev);
+  const Features b = subset(kf_new, index_new);
+  if (a.keypoints.empty() || b.keypoints.empty()) return;
+
+  // Predict through the previous key-frame's median depth (the ground is nearly a plane).
+  std::vector<double> depths;
+  const Eigen::Isometry3d T_prev_world = kf_prev.T_world_cam.inverse();
+  for (int id : kf_prev.point_of_feature)
+    if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad)
+      depths.push_back((T_prev_world * points_[static_cast<std::size_t>(id)].p_world).z());
+  const double depth = median(depths);
+  if (!(depth > 0.0)) return;
+  const Eigen::Isometry3d T_new_prev = kf_new.T_world_cam.inverse() * kf_prev.T_world_cam;
+  std::vector<cv::Point2f> predicted;
+  for (const cv::KeyPoint& kp : a.keypoints) {
+    const Eigen::Vector3d ray((kp.pt.x - K(0, 2)) / K(0, 0), (kp.pt.y - K(1, 2)) / K(1, 1), 1.0);
+    const Eigen::Vector3d p_new = T_new_prev * (depth * ray);
+    if (p_new.z() <= 0.0) {
+      predicted.emplace_back(-1e6f, -1e6f);
+      continue;
+    }
+    const Eigen::Vector2d px = project(K, p_new);
+    predicted.emplace_back(static_cast<float>(px.x()), static_cast<float>(px.y()));
+  }
+  std::vector<cv::DMatch> matches =
+      matchByWindow(a, b, predicted, params_.track_wide_radius_px, params_.max_hamming,
+                    static_cast<float>(params_.match_ratio));
+  matches = filterByOrientation(a, b, matches);
+
+  TriangulationChecks checks;
+  checks.min_parallax_deg = std::max(1.0, params_.two_view.min_point_parallax_deg);
+  checks.max_reprojection_error_px = params_.two_view.max_reprojection_error_px;
+  for (const cv::DMatch& m : matches) {
+    const Triangulation t = triangulate(a.keypoints[static_cast<std::size_t>(m.queryIdx)].pt,
+                                        b.keypoints[static_cast<std::size_t>(m.trainIdx)].pt,
+                                        T_new_prev.linear(), T_new_prev.translation(), K, checks);
+    if (t.status != TriangulationStatus::kOk) continue;
+    const int i_new = index_new[static_cast<std::size_t>(m.trainIdx)];
+    MapPoint mp;
+    mp.p_world = kf_prev.T_world_cam * t.p_1;
+    mp.descriptor = kf_new.features.descriptors.row(i_new).clone();
+    const int id = static_cast<int>(points_.size());
+    points_.push_back(std::move(mp));
+    kf_prev.point_of_feature[static_cast<std::size_t>(
+        index_prev[static_cast<std::size_t>(m.queryIdx)])] = id;
+    kf_new.point_of_feature[static_cast<std::size_t>(i_new)] = id;
+  }
+}
+
+void FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
+  const int n = static_cast<int>(keyframes_.size());
+  if (n < 2) return;
+  BaProblem problem;
+  problem.K = baIntrinsics(K);
+  // Only the oldest key-frame is fixed: the scale stays free, so the height
+  // correction of the newest key-frame's points spreads instead of being pulled back.
+  const int fixed = std::min(1, n - 1);
+  for (int k = 0; k < n; ++k)
+    problem.cameras.push_back({keyframes_[static_cast<std::size_t>(k)].T_world_cam, k < fixed});
+  std::unordered_map<int, int> ba_index;
+  std::vector<int> point_ids;
+  struct Ref {
+    int kf;
+    std::size_t feature;
+  };
+  std::vector<Ref> refs;
+  for (int k = 0; k < n; ++k) {
+    const Frame& kf = keyframes_[static_cast<std::size_t>(k)];
+    for (std::size_t i = 0; i < kf.point_of_feature.size(); ++i) {
+      const int id = kf.point_of_feature[i];
+      if (id < 0 || points_[static_cast<std::size_t>(id)].bad) continue;
+      auto [it, inserted] = ba_index.emplace(id, static_cast<int>(point_ids.size()));
+      if (inserted) {
+        point_ids.push_back(id);
+        problem.points.push_back({points_[static_cast<std::size_t>(id)].p_world, false});
+      }
+      const cv::KeyPoint& kp = kf.features.keypoints[i];
+      problem.observations.push_back(
+          {k, it->second, Eigen::Vector2d(kp.pt.x, kp.pt.y),
+           std::pow(static_cast<double>(params_.features.scale_factor), kp.octave)});
+      refs.push_back({k, i});
+    }
+  }
+  BundleAdjustmentParams ba = params_.ba;
+  ba.num_threads = 1;
+  const BaResult result = bundleAdjust(problem, ba);
+  for (int k = 0; k < n; ++k)
+    keyframes_[static_cast<std::size_t>(k)].T_world_cam =
+        problem.cameras[static_cast<std::size_t>(k)].T_world_cam;
+  for (std::size_t j = 0; j < point_ids.size(); ++j)
+    points_[static_cast<std::size_t>(point_ids[j])].p_world = problem.points[j].p_world_m;
+  for (std::size_t o = 0; o < refs.size(); ++o)
+    if (result.outlier[o])
+      keyframes_[static_cast<std::size_t>(refs[o].kf)].point_of_feature[refs[o].feature] = -1;
+}
+
+}  // namespace nadir::vo

@@ -1,0 +1,230 @@
+// FeatureVo on synthetic flights: a random-texture ground plane 150 m below,
+// rendered into each 1280x960 frame with the exact homography of the camera
+// pose, along a known trajectory (straight and level, then a gentle banked turn).
+
+#include "nodes/vo_feature/feature_vo.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "core/frames.h"
+
+namespace nadir::vo {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr int kWidth = 1280;
+constexpr int kHeight = 960;
+constexpr double kAltitudeM = 150.0;  // ground at world z = 0, the camera at z = -150
+constexpr double kTextureResM = 0.2;  // ground metres per texture pixel
+constexpr int kTextureSize = 4000;    // covers +-400 m north and east
+constexpr double kTextureHalfM = 400.0;
+constexpr double kDtS = 0.1;
+constexpr double kSpeedMps = 20.0;
+const cv::Matx33d kK(800, 0, 640, 0, 800, 480, 0, 0, 1);
+
+// Multi-scale random texture: noise at four scales, fixed seed.
+const cv::Mat& groundTexture() {
+  static const cv::Mat texture = [] {
+    cv::RNG rng(12345);
+    cv::Mat sum = cv::Mat::zeros(kTextureSize, kTextureSize, CV_32F);
+    for (int k = 0; k < 4; ++k) {
+      const int size = kTextureSize >> k;
+      cv::Mat noise(size, size, CV_32F);
+      rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::Mat up;
+      cv::resize(noise, up, sum.size(), 0, 0, cv::INTER_CUBIC);
+      sum += up;
+    }
+    cv::GaussianBlur(sum, sum, cv::Size(0, 0), 1.0);
+    cv::Mat out;
+    cv::normalize(sum, sum, 0, 255, cv::NORM_MINMAX);
+    sum.convertTo(out, CV_8U);
+    cv::equalizeHist(out, out);
+    return out;
+  }();
+  return texture;
+}
+
+Eigen::Isometry3d bodyPose(const Eigen::Vector3d& p, double roll, double pitch, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                   .matrix();
+  T.translation() = p;
+  return T;
+}
+
+// The frame a camera at T_world_cam sees: texture pixel (u, v) is the ground
+// point north = 400 - 0.2 v, east = -400 + 0.2 u, down = 0.
+cv::Mat render(const Eigen::Isometry3d& T_world_cam) {
+  Eigen::Matrix3d A;
+  A << 0, -kTextureResM, kTextureHalfM, kTextureResM, 0, -kTextureHalfM, 0, 0, 0;
+  const Eigen::Matrix3d R_cw = T_world_cam.linear().transpose();
+  Eigen::Matrix3d M = A;
+  M.col(2) -= T_world_cam.translation();
+  Eigen::Matrix3d K;
+  K << kK(0, 0), 0, kK(0, 2), 0, kK(1, 1), kK(1, 2), 0, 0, 1;
+  const Eigen::Matrix3d H = K * R_cw * M;
+  cv::Matx33d H_cv;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) H_cv(r, c) = H(r, c);
+  cv::Mat frame;
+  cv::warpPerspective(groundTexture(), frame, H_cv, cv::Size(kWidth, kHeight), cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, cv::Scalar(0));
+  return frame;
+}
+
+// Straight and level north for 60 frames, then a right turn at 3 deg/s with
+// the roll eased in to 6 deg over 10 frames.
+std::vector<Eigen::Isometry3d> trajectory(int frames) {
+  std::vector<Eigen::Isometry3d> poses;
+  Eigen::Vector3d p(-150.0, -60.0, -kAltitudeM);
+  double yaw = 0.0;
+  for (int i = 0; i < frames; ++i) {
+    const int turn = i - 60;
+    const double roll = turn <= 0 ? 0.0 : 6.0 * kDeg * std::min(1.0, turn / 10.0);
+    poses.push_back(bodyPose(p, roll, 0.0, yaw));
+    if (turn > 0) yaw += 3.0 * kDeg * kDtS * std::min(1.0, turn / 10.0);
+    p += kSpeedMps * kDtS * Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  return poses;
+}
+
+struct FlightRun {
+  std::vector<Eigen::Isometry3d> truth;
+  std::vector<VoFrameOutput> out;
+  double ms_per_frame = 0.0;
+  double scale_ratio = 1.0;  // map height / measured height at the last key-frame
+};
+
+FlightRun fly(int frames, int noise_frame = -1) {
+  FlightRun run;
+  run.truth = trajectory(frames);
+  FeatureVo vo(FeatureVoParams{});
+  vo.setStartPose(run.truth.front());
+  const Eigen::Matrix3d R_body_cam = core::rotationBodyFromDownCamera();
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  T_body_cam.linear() = R_body_cam;
+  cv::RNG rng(7);
+  double total_ms = 0.0;
+  for (int i = 0; i < frames; ++i) {
+    VoFrameInput in;
+    in.utime = static_cast<std::int64_t>(i) * 100000;
+    in.K = kK;
+    in.R_body_cam = R_body_cam;
+    in.height_agl_m = -run.truth[static_cast<std::size_t>(i)].translation().z();
+    if (i == noise_frame) {
+      in.gray = cv::Mat(kHeight, kWidth, CV_8U);
+      rng.fill(in.gray, cv::RNG::UNIFORM, 0, 256);
+    } else {
+      in.gray = render(run.truth[static_cast<std::size_t>(i)] * T_body_cam);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    run.out.push_back(vo.process(in));
+    total_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  run.ms_per_frame = total_ms / frames;
+  run.scale_ratio = vo.lastScaleRatio();
+  return run;
+}
+
+int firstTracking(const FlightRun& run) {
+  for (std::size_t i = 0; i < run.out.size(); ++i)
+    if (run.out[i].status == VoStatus::kTracking) return static_cast<int>(i);
+  return -1;
+}
+
+double pathLength(const std::vector<Eigen::Vector3d>& p) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < p.size(); ++i) length += (p[i] - p[i - 1]).norm();
+  return length;
+}
+
+// Initialises within a few frames at metric scale, tracks the whole flight, ends within 2 % of the
+// distance.
+TEST(FeatureVo, TracksStraightAndTurningFlightAtMetricScale) {
+  constexpr int kFrames = 120;
+  const FlightRun run = fly(kFrames);
+  const int first = firstTracking(run);
+  ASSERT_GE(first, 1);
+  EXPECT_LE(first, 10);
+  std::vector<Eigen::Vector3d> est, tru;
+  for (int i = first; i < kFrames; ++i) {
+    EXPECT_EQ(run.out[static_cast<std::size_t>(i)].status, VoStatus::kTracking) << "frame " << i;
+    est.push_back(run.out[static_cast<std::size_t>(i)].T_world_body.translation());
+    tru.push_back(run.truth[static_cast<std::size_t>(i)].translation());
+  }
+  const double length_est = pathLength(est);
+  const double length_true = pathLength(tru);
+  const double flown = pathLength([&] {
+    std::vector<Eigen::Vector3d> all;
+    for (const auto& T : run.truth) all.push_back(T.translation());
+    return all;
+  }());
+  const double end_error =
+      (run.out.back().T_world_body.translation() - run.truth.back().translation()).norm();
+  const double yaw_error_deg = Eigen::AngleAxisd(run.out.back().T_world_body.linear().transpose() *
+                                                 run.truth.back().linear())
+                                   .angle() /
+                               kDeg;
+  int keyframes = 0;
+  for (const auto& o : run.out) keyframes += o.new_keyframe ? 1 : 0;
+  std::printf(
+      "feature_vo: init at frame %d, length %.2f / %.2f m, end error %.2f m of %.1f m flown, "
+      "attitude error %.2f deg, %d key-frames, map/measured height %.4f, %.1f ms per 1280x960 "
+      "frame\n",
+      first, length_est, length_true, end_error, flown, yaw_error_deg, keyframes, run.scale_ratio,
+      run.ms_per_frame);
+  EXPECT_NEAR(length_est / length_true, 1.0, 0.03);
+  EXPECT_LT(end_error, 0.02 * flown);
+  EXPECT_LT(yaw_error_deg, 1.0);
+  EXPECT_EQ(run.out.back().resets, 0);
+}
+
+// A frame of pure noise mid-flight is LOST; the next frames track again and the pose does not jump.
+TEST(FeatureVo, NoiseFrameIsLostThenRecoversWithoutJump) {
+  constexpr int kFrames = 80;
+  constexpr int kNoise = 40;
+  const FlightRun run = fly(kFrames, kNoise);
+  EXPECT_EQ(run.out[kNoise].status, VoStatus::kLost);
+  int recovered = -1;
+  for (int i = kNoise + 1; i < kFrames; ++i)
+    if (run.out[static_cast<std::size_t>(i)].status == VoStatus::kTracking) {
+      recovered = i;
+      break;
+    }
+  ASSERT_GT(recovered, kNoise);
+  EXPECT_LE(recovered, kNoise + 3);
+  // Every published step around the lost frame is within 1 m of the true 2 m step.
+  for (int i = kNoise - 1; i < kFrames; ++i) {
+    const double step = (run.out[static_cast<std::size_t>(i)].T_world_body.translation() -
+                         run.out[static_cast<std::size_t>(i) - 1].T_world_body.translation())
+                            .norm();
+    EXPECT_NEAR(step, kSpeedMps * kDtS, 1.0) << "frame " << i;
+  }
+  for (int i = recovered; i < kFrames; ++i)
+    EXPECT_EQ(run.out[static_cast<std::size_t>(i)].status, VoStatus::kTracking) << "frame " << i;
+  double flown = 0.0;
+  for (int i = 1; i < kFrames; ++i)
+    flown += (run.truth[static_cast<std::size_t>(i)].translation() -
+              run.truth[static_cast<std::size_t>(i) - 1].translation())
+                 .norm();
+  const double end_error =
+      (run.out.back().T_world_body.translation() - run.truth.back().translation()).norm();
+  std::printf("feature_vo lost case: recovered at frame %d, end error %.2f m of %.1f m flown\n",
+              recovered, end_error, flown);
+  EXPECT_LT(end_error, 0.02 * flown);
+}
+
+}  // namespace
+}  // namespace nadir::vo
