@@ -119,8 +119,14 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
                    withScenario({scenario.ppa.enabled ? programPath(bin_dir, "nadir-ppa")
                                                       : std::string("nadir-ppa")}),
                    nodeLog("ppa"));
+  ChildProcess vo_feature(
+      "nadir-vo-feature",
+      withScenario({scenario.vo_feature.enabled ? programPath(bin_dir, "nadir-vo-feature")
+                                                : std::string("nadir-vo-feature")}),
+      nodeLog("vo_feature"));
   std::vector<ChildProcess*> listeners = {&camera};
   if (scenario.ppa.enabled) listeners.push_back(&ppa);
+  if (scenario.vo_feature.enabled) listeners.push_back(&vo_feature);
   std::vector<ChildProcess*> nodes = {&logger};
   nodes.insert(nodes.end(), listeners.begin(), listeners.end());
   nodes.push_back(&simulator);

@@ -18,6 +18,7 @@
 #include "nodes/ppa/ppa_node.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
+#include "nodes/vo_feature/vo_feature_node.h"
 #include "run/target_passes.h"
 #include "run/track_plot.h"
 #include "scenario/scenario.h"
@@ -91,6 +92,12 @@ RunResult runScenario(const RunOptions& options,
   std::vector<std::pair<double, bool>> detector_frames;
   std::vector<core::Subscription> detector_subscription;
   const std::vector<Eigen::Vector2d> targets_ne_m = scenario::knownTargets(scenario, frame);
+  std::optional<vo::VoFeatureNode> vo_feature_node;
+  if (scenario.vo_feature.enabled) {
+    vo::VoFeatureNodeParams params = scenario.vo_feature;
+    params.wall_clock_timing = false;  // byte-identical runs
+    vo_feature_node.emplace(*bus, params);
+  }
   if (scenario.ppa.enabled) {
     ppa_node.emplace(*bus, scenario.ppa, targets_ne_m);
     detector_subscription.push_back(core::subscribe<nadir::target_detection_t>(

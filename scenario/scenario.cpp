@@ -34,6 +34,7 @@ void ScenarioParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "tiles", "terrain tiles and levels of detail", tiles);
   core::visitGroup(v, "renderer", "terrain drawing", renderer);
   core::visitGroup(v, "ppa", "the emulated SCAMP-5 vision sensor (nadir-ppa)", ppa);
+  core::visitGroup(v, "vo_feature", "the feature-based VO (nadir-vo-feature)", vo_feature);
   core::visitGroup(v, "time", "how sim time runs", time);
   core::visitGroup(v, "bus", "where the streams go", bus);
 }

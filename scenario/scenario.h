@@ -18,6 +18,7 @@
 #include "nodes/camera/camera_rig.h"
 #include "nodes/ppa/ppa_node_params.h"
 #include "nodes/sim/sim_params.h"
+#include "nodes/vo_feature/vo_feature_node.h"
 #include "render/terrain_renderer.h"
 #include "terrain/targets.h"
 #include "terrain/tiles.h"
@@ -45,8 +46,9 @@ struct ScenarioParams {
   std::map<std::string, terrain::GroundTarget> targets;
   terrain::TileParams tiles;
   render::TerrainRendererParams renderer;
-  // The VO nodes: the emulated SCAMP-5 vision sensor.
+  // The VO nodes: the emulated SCAMP-5 vision sensor and the feature-based VO.
   ppa::PpaNodeParams ppa;
+  vo::VoFeatureNodeParams vo_feature;
   TimeParams time;
   core::BusParams bus;
 

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -148,6 +149,24 @@ TEST(Run, PpaTargetCorrectionOnEveryPass) {
   }
 }
 
+// The feature VO on half a minute of the demo flight (120 m AGL, 640x480 at 20 frames/s):
+// it initialises, tracks and stays metric from the rangefinder.
+TEST(Run, FeatureVoTracksTheDemoFlight) {
+  RunOptions options;
+  options.scenario = "default";
+  options.out_dir = tempDir("vo_feature");
+  options.overrides = {"duration_s=30"};
+  options.record_images = false;
+  const RunResult result = runScenario(options);
+  ASSERT_EQ(result.metrics.sources.count("vo_feature"), 1u);
+  const eval::SourceMetrics& vo = result.metrics.sources.at("vo_feature");
+  EXPECT_TRUE(vo.initialised);
+  EXPECT_GT(vo.tracked_pct, 95.0);
+  EXPECT_LT(vo.position_rmse_m, 5.0);
+  EXPECT_LT(vo.rotation_rmse_deg, 1.0);
+  EXPECT_LT(std::abs(vo.track_length_diff_pct), 3.0);
+}
+
 // A sweep file's grid: every combination, last axis fastest, named by its values.
 TEST(Sweep, PlansTheGrid) {
   const std::string dir = tempDir("sweep_plan");
@@ -268,7 +287,7 @@ TEST(Launch, ADeadNodeIsReported) {
   LaunchOptions options;
   options.scenario = "default";
   options.out_dir = (fs::path(dir) / "out").string();
-  options.overrides = {"duration_s=30"};
+  options.overrides = {"duration_s=30", "vo_feature.enabled=false"};
   options.bin_dir = bin.string();
   std::atomic<bool> stop{false};
   std::ostringstream out;

@@ -1,0 +1,146 @@
+#include "nodes/vo_feature/vo_feature_node.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/frames.h"
+#include "nadir/vo_estimate_t.hpp"
+#include "nodes/camera/camera_messages.h"
+
+namespace nadir::vo {
+namespace {
+
+constexpr std::size_t kAttitudeHistory = 64;
+
+}  // namespace
+
+void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
+  v.field("enabled", &enabled, {.doc = "run the feature VO in this scenario"});
+  v.field("image_channel", &image_channel, {.doc = "the camera's images (gray or RGB)"});
+  v.field("info_channel", &info_channel, {.doc = "its camera_info_t (intrinsics, mount)"});
+  v.field("range_channel", &range_channel, {.doc = "range_t: height above ground, for scale"});
+  v.field("attitude_channel", &attitude_channel,
+          {.doc = "attitude_t: the flight controller's attitude (for attitude_prior)"});
+  v.field("truth_channel", &truth_channel, {.doc = "pose_t read once: the start pose"});
+  v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
+  v.field("attitude_prior", &attitude_prior,
+          {.doc = "use the flight controller's attitude as each frame's rotation prior"});
+  v.field("wall_clock_timing", &wall_clock_timing,
+          {.doc = "publish wall-clock processing time (0 keeps runs byte-identical)"});
+  core::visitGroup(v, "vo", "the visual odometry", vo);
+}
+
+VoFeatureNode::VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params)
+    : bus_(bus), params_(params), vo_(params.vo) {
+  subscriptions_.push_back(core::subscribe<nadir::range_t>(
+      bus_, params_.range_channel, [this](const nadir::range_t& range) { range_ = range; }));
+  subscriptions_.push_back(core::subscribe<nadir::attitude_t>(
+      bus_, params_.attitude_channel, [this](const nadir::attitude_t& attitude) {
+        attitudes_.push_back(attitude);
+        if (attitudes_.size() > kAttitudeHistory) attitudes_.pop_front();
+      }));
+  subscriptions_.push_back(core::subscribe<nadir::pose_t>(
+      bus_, params_.truth_channel, [this](const nadir::pose_t& pose) {
+        if (started_) return;
+        try {
+          vo_.setStartPose(camera::bodyPoseFromMessage(pose));
+          started_ = true;
+        } catch (const std::invalid_argument&) {
+        }
+      }));
+  subscriptions_.push_back(core::subscribe<nadir::camera_info_t>(
+      bus_, params_.info_channel, [this](const nadir::camera_info_t& info) {
+        if (!info_ || info_->width != info.width || info_->height != info.height ||
+            info_->fx != info.fx || info_->num_distortion != info.num_distortion) {
+          undistort_map_x_.release();
+        }
+        info_ = info;
+      }));
+  subscriptions_.push_back(core::subscribe<nadir::image_t>(
+      bus_, params_.image_channel, [this](const nadir::image_t& image) { onImage(image); }));
+}
+
+void VoFeatureNode::drop(const std::string& reason) {
+  if (dropped_images_++ == 0) first_drop_reason_ = reason;
+}
+
+void VoFeatureNode::onImage(const nadir::image_t& image) {
+  if (!info_ || !started_) return;  // the lens and the start pose come first
+  cv::Mat frame;
+  try {
+    frame = camera::imageFromMessage(image);
+  } catch (const std::exception& error) {
+    drop(error.what());
+    return;
+  }
+  if (frame.cols != info_->width || frame.rows != info_->height) {
+    drop("image " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
+         " does not match camera_info_t's " + std::to_string(info_->width) + "x" +
+         std::to_string(info_->height));
+    return;
+  }
+  cv::Mat gray;
+  if (frame.channels() == 3) {
+    cv::cvtColor(frame, gray, cv::COLOR_RGB2GRAY);
+  } else {
+    gray = frame;
+  }
+  const cv::Matx33d K(info_->fx, 0, info_->cx, 0, info_->fy, info_->cy, 0, 0, 1);
+  bool distorted = false;
+  for (int i = 0; i < info_->num_distortion; ++i)
+    distorted = distorted || info_->distortion[i] != 0.0;
+  if (distorted) {
+    if (undistort_map_x_.empty()) {
+      const std::vector<double> coefficients(info_->distortion.begin(), info_->distortion.end());
+      cv::initUndistortRectifyMap(K, coefficients, cv::noArray(), K, gray.size(), CV_32FC1,
+                                  undistort_map_x_, undistort_map_y_);
+    }
+    cv::Mat undistorted;
+    cv::remap(gray, undistorted, undistort_map_x_, undistort_map_y_, cv::INTER_LINEAR);
+    gray = undistorted;
+  }
+
+  std::optional<Eigen::Quaterniond> attitude;
+  for (auto it = attitudes_.rbegin(); it != attitudes_.rend(); ++it) {
+    if (it->utime <= image.utime) {
+      attitude = core::quaternionFromWire(it->orientation);
+      break;
+    }
+  }
+  VoFrameInput input;
+  input.utime = image.utime;
+  input.gray = gray;
+  input.K = K;
+  input.R_body_cam = core::quaternionFromWire(info_->orientation_body_cam).toRotationMatrix();
+  if (range_ && range_->status == nadir::range_t::STATUS_VALID) {
+    // Height from the slant range along the body-down ray (level: the range itself).
+    const double down = attitude ? attitude->toRotationMatrix()(2, 2) : 1.0;
+    input.height_agl_m = range_->range_m * std::max(down, 0.0);
+  }
+  if (params_.attitude_prior) input.q_world_body_prior = attitude;
+
+  const auto started = std::chrono::steady_clock::now();
+  const VoFrameOutput out = vo_.process(input);
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  processing_s_ += elapsed_s;
+  ++frames_;
+
+  nadir::vo_estimate_t estimate{};
+  estimate.utime = image.utime;
+  estimate.source = "vo_feature";
+  estimate.status = out.status == VoStatus::kTracking ? nadir::vo_estimate_t::STATUS_TRACKING
+                    : out.status == VoStatus::kLost   ? nadir::vo_estimate_t::STATUS_LOST
+                                                      : nadir::vo_estimate_t::STATUS_INITIALIZING;
+  estimate.pose.utime = image.utime;
+  const Eigen::Vector3d p = out.T_world_body.translation();
+  for (int i = 0; i < 3; ++i) estimate.pose.pos[i] = p[i];
+  core::quaternionToWire(Eigen::Quaterniond(out.T_world_body.rotation()),
+                         estimate.pose.orientation);
+  estimate.num_features = out.tracked_points;
+  estimate.num_resets = out.resets;
+  estimate.processing_time_s = params_.wall_clock_timing ? elapsed_s : 0.0;
+  core::publish(bus_, params_.pose_channel, estimate);
+}
+
+}  // namespace nadir::vo

@@ -1,0 +1,78 @@
+#pragma once
+// nadir-vo-feature's work on a bus, the same in the live node and in `nadir
+// run`: the downward camera's frames go through FeatureVo with the
+// rangefinder's height (and optionally the flight controller's attitude as a
+// prior), and vo_estimate_t goes out on POSE_VO_FEATURE. Bad messages are
+// dropped and counted.
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/bus.h"
+#include "core/params.h"
+#include "nadir/attitude_t.hpp"
+#include "nadir/camera_info_t.hpp"
+#include "nadir/image_t.hpp"
+#include "nadir/pose_t.hpp"
+#include "nadir/range_t.hpp"
+#include "nodes/vo_feature/feature_vo.h"
+
+namespace nadir::vo {
+
+struct VoFeatureNodeParams {
+  // In a scenario: run the feature VO (nadir run composes it, nadir launch starts
+  // nadir-vo-feature).
+  bool enabled = false;
+  std::string image_channel = "CAMERA_DOWN";
+  std::string info_channel = "CAMERA_DOWN_INFO";
+  std::string range_channel = "RANGE";
+  std::string attitude_channel = "NAV_ATTITUDE";
+  // Read once: the start pose the estimate is anchored to.
+  std::string truth_channel = "POSE_TRUTH";
+  std::string pose_channel = "POSE_VO_FEATURE";
+  // Use the flight controller's attitude as a prior for each frame's rotation.
+  bool attitude_prior = false;
+  // Publish the wall-clock processing time in vo_estimate_t (live); off, it is
+  // 0 so that runs are byte-identical (nadir run turns it off).
+  bool wall_clock_timing = true;
+  FeatureVoParams vo;
+
+  void visit(core::ParamVisitor& v);
+};
+
+class VoFeatureNode {
+ public:
+  VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params);
+
+  std::uint64_t frames() const { return frames_; }
+  std::uint64_t droppedImages() const { return dropped_images_; }
+  const std::string& firstDropReason() const { return first_drop_reason_; }
+  // Wall-clock seconds spent in FeatureVo::process, over all frames.
+  double processingSeconds() const { return processing_s_; }
+
+ private:
+  void onImage(const nadir::image_t& image);
+  void drop(const std::string& reason);
+
+  core::Bus& bus_;
+  VoFeatureNodeParams params_;
+  FeatureVo vo_;
+  std::optional<nadir::camera_info_t> info_;
+  std::optional<nadir::range_t> range_;
+  std::deque<nadir::attitude_t> attitudes_;
+  bool started_ = false;
+  std::uint64_t frames_ = 0;
+  std::uint64_t dropped_images_ = 0;
+  double processing_s_ = 0.0;
+  std::string first_drop_reason_;
+  cv::Mat undistort_map_x_, undistort_map_y_;
+  std::vector<core::Subscription> subscriptions_;
+};
+
+}  // namespace nadir::vo
