@@ -11,8 +11,6 @@
 namespace nadir::ppa {
 namespace {
 
-constexpr std::size_t kAttitudeHistory = 64;
-
 void visitArray(core::ParamVisitor& v, PpaParams& array) {
   v.field("analog_noise_sigma", &array.analog_noise_sigma,
           {.doc = "noise of each analog write, counts; 0 = none", .min = 0, .max = 50});
@@ -61,14 +59,8 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
       host_(params.host,
             PpaCamera::fromFov(kWidth, kHeight, params.host.hfov_deg * std::numbers::pi / 180.0,
                                core::rotationBodyFromDownCamera()),
-            std::move(targets_ne_m)) {
-  subscriptions_.push_back(core::subscribe<nadir::range_t>(
-      bus_, params_.range_channel, [this](const nadir::range_t& range) { range_ = range; }));
-  subscriptions_.push_back(core::subscribe<nadir::attitude_t>(
-      bus_, params_.attitude_channel, [this](const nadir::attitude_t& attitude) {
-        attitudes_.push_back(attitude);
-        if (attitudes_.size() > kAttitudeHistory) attitudes_.pop_front();
-      }));
+            std::move(targets_ne_m)),
+      inputs_(bus, params.range_channel, params.attitude_channel) {
   subscriptions_.push_back(core::subscribe<nadir::pose_t>(bus_, params_.truth_channel,
                                                           [this](const nadir::pose_t& pose) {
                                                             if (!first_truth_) first_truth_ = pose;
@@ -126,18 +118,13 @@ void PpaNode::onImage(const nadir::image_t& image) {
   ++frames_;
 
   // The attitude at (or just before) the frame.
-  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
-  for (auto it = attitudes_.rbegin(); it != attitudes_.rend(); ++it) {
-    if (it->utime <= image.utime) {
-      q_world_body = core::quaternionFromWire(it->orientation);
-      break;
-    }
-  }
+  const Eigen::Quaterniond q_world_body =
+      inputs_.attitudeAt(image.utime).value_or(Eigen::Quaterniond::Identity());
   PpaHostInput input;
   input.utime = image.utime;
   input.alignment = {vo.translation_x_px, vo.translation_y_px, vo.rotation_rad,       vo.scale,
                      vo.strength,         vo.new_keyframe,     vo.keyframe_edge_count};
-  if (range_ && range_->status == nadir::range_t::STATUS_VALID) input.range_m = range_->range_m;
+  input.range_m = inputs_.validRange_m();
   input.q_world_body = q_world_body;
   // Only a target wholly in view corrects the position: a box cut by the
   // image's border has a shifted centre.

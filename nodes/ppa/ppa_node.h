@@ -7,7 +7,6 @@
 // dropped and counted.
 
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,11 +14,10 @@
 #include <Eigen/Core>
 
 #include "core/bus.h"
-#include "nadir/attitude_t.hpp"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/pose_t.hpp"
-#include "nadir/range_t.hpp"
+#include "nodes/common/flight_inputs.h"
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/ppa_host.h"
 #include "nodes/ppa/ppa_node_params.h"
@@ -50,8 +48,7 @@ class PpaNode {
   VisualOdometry vo_;
   TargetExtractor extractor_;
   PpaHost host_;
-  std::optional<nadir::range_t> range_;
-  std::deque<nadir::attitude_t> attitudes_;
+  nodes::FlightInputs inputs_;
   std::optional<nadir::pose_t> first_truth_;
   std::uint64_t frames_ = 0;
   std::uint64_t dropped_images_ = 0;

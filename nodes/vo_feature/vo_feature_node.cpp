@@ -8,12 +8,6 @@
 #include "nodes/camera/camera_messages.h"
 
 namespace nadir::vo {
-namespace {
-
-constexpr std::size_t kAttitudeHistory = 64;
-
-}  // namespace
-
 void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the feature VO in this scenario"});
   v.field("image_channel", &image_channel, {.doc = "the camera's images (gray or RGB)"});
@@ -31,14 +25,10 @@ void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
 }
 
 VoFeatureNode::VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params)
-    : bus_(bus), params_(params), vo_(params.vo) {
-  subscriptions_.push_back(core::subscribe<nadir::range_t>(
-      bus_, params_.range_channel, [this](const nadir::range_t& range) { range_ = range; }));
-  subscriptions_.push_back(core::subscribe<nadir::attitude_t>(
-      bus_, params_.attitude_channel, [this](const nadir::attitude_t& attitude) {
-        attitudes_.push_back(attitude);
-        if (attitudes_.size() > kAttitudeHistory) attitudes_.pop_front();
-      }));
+    : bus_(bus),
+      params_(params),
+      vo_(params.vo),
+      inputs_(bus, params.range_channel, params.attitude_channel) {
   subscriptions_.push_back(core::subscribe<nadir::pose_t>(
       bus_, params_.truth_channel, [this](const nadir::pose_t& pose) {
         if (started_) return;
@@ -100,22 +90,16 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
     gray = undistorted;
   }
 
-  std::optional<Eigen::Quaterniond> attitude;
-  for (auto it = attitudes_.rbegin(); it != attitudes_.rend(); ++it) {
-    if (it->utime <= image.utime) {
-      attitude = core::quaternionFromWire(it->orientation);
-      break;
-    }
-  }
+  const std::optional<Eigen::Quaterniond> attitude = inputs_.attitudeAt(image.utime);
   VoFrameInput input;
   input.utime = image.utime;
   input.gray = gray;
   input.K = K;
   input.R_body_cam = core::quaternionFromWire(info_->orientation_body_cam).toRotationMatrix();
-  if (range_ && range_->status == nadir::range_t::STATUS_VALID) {
+  if (const auto range_m = inputs_.validRange_m()) {
     // Height from the slant range along the body-down ray (level: the range itself).
     const double down = attitude ? attitude->toRotationMatrix()(2, 2) : 1.0;
-    input.height_agl_m = range_->range_m * std::max(down, 0.0);
+    input.height_agl_m = *range_m * std::max(down, 0.0);
   }
   if (params_.attitude_prior) input.q_world_body_prior = attitude;
 

@@ -7,7 +7,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,11 +15,10 @@
 
 #include "core/bus.h"
 #include "core/params.h"
-#include "nadir/attitude_t.hpp"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/pose_t.hpp"
-#include "nadir/range_t.hpp"
+#include "nodes/common/flight_inputs.h"
 #include "nodes/vo_feature/feature_vo.h"
 
 namespace nadir::vo {
@@ -64,8 +62,7 @@ class VoFeatureNode {
   VoFeatureNodeParams params_;
   FeatureVo vo_;
   std::optional<nadir::camera_info_t> info_;
-  std::optional<nadir::range_t> range_;
-  std::deque<nadir::attitude_t> attitudes_;
+  nodes::FlightInputs inputs_;
   bool started_ = false;
   std::uint64_t frames_ = 0;
   std::uint64_t dropped_images_ = 0;
