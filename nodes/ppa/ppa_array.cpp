@@ -586,35 +586,32 @@ void Ppa::all() {
 // Fused loops: each PE's transfers run in order in registers, so one pass over
 // the planes does the work of several instructions.
 
-void Ppa::mov(Areg dst, Areg src) {
+// The two-transfer macros: the first transfer's value (already negated) into
+// NEWS, then NEWS negated into dst.
+template <class FirstTransfer>
+void Ppa::viaNews(Areg dst, FirstTransfer first) {
   instructions_ += 2;
-  runAnalog(2, [this, dst, src](auto noise, auto write) {
+  runAnalog(2, [this, dst, &first](auto noise, auto write) {
     float* d = plane(dst).data();
     float* news = plane(Areg::NEWS).data();
-    const float* s = plane(src).data();
     for (int i = 0; i < kPes; i += kLanes) {
       const auto here = write.at(i);  // FLAG of these PEs
-      const F4 t = saturate(noise(0, i, -load4(s + i)));
+      const F4 t = saturate(noise(0, i, first(i)));
       write(news, i, t, here);
       write(d, i, saturate(noise(1, i, -t)), here);
     }
   });
 }
 
+void Ppa::mov(Areg dst, Areg src) {
+  const float* s = plane(src).data();
+  viaNews(dst, [s](int i) { return -load4(s + i); });
+}
+
 void Ppa::add(Areg dst, Areg src1, Areg src2) {
-  instructions_ += 2;
-  runAnalog(2, [this, dst, src1, src2](auto noise, auto write) {
-    float* d = plane(dst).data();
-    float* news = plane(Areg::NEWS).data();
-    const float* a = plane(src1).data();
-    const float* b = plane(src2).data();
-    for (int i = 0; i < kPes; i += kLanes) {
-      const auto here = write.at(i);  // FLAG of these PEs
-      const F4 t = saturate(noise(0, i, -(load4(a + i) + load4(b + i))));
-      write(news, i, t, here);
-      write(d, i, saturate(noise(1, i, -t)), here);
-    }
-  });
+  const float* a = plane(src1).data();
+  const float* b = plane(src2).data();
+  viaNews(dst, [a, b](int i) { return -(load4(a + i) + load4(b + i)); });
 }
 
 void Ppa::sub(Areg dst, Areg src1, Areg src2) {

@@ -162,6 +162,8 @@ class Ppa {
   // that fit the current parameters and FLAG (defined in ppa_array.cpp).
   template <class Kernel>
   void runAnalog(int transfers, Kernel&& kernel);
+  template <class FirstTransfer>
+  void viaNews(Areg dst, FirstTransfer first);
   // Updates flag_all_ after FLAG changed.
   void flagChanged();
   // Fills noise_[k] with a fresh plane of Gaussian noise, sigma = analog_noise_sigma.
