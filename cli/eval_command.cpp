@@ -30,28 +30,14 @@ void evaluateRun(const EvalCommandOptions& options) {
   if (!fs::exists(log)) throw eval::EvalError(log.string() + ": no such file or directory");
   const fs::path dir = log.has_parent_path() ? log.parent_path() : fs::path(".");
 
-  const eval::LogTrajectories recorded = eval::readRunLog(log.string());
-  if (!recorded.damage.empty()) {
-    std::cerr << "nadir eval: warning: " << log.string() << ": " << recorded.damage << "\n";
+  const eval::RunEvaluation run = eval::evaluateRunLog(log.string(), dir.string(), options.eval);
+  if (!run.recorded.damage.empty()) {
+    std::cerr << "nadir eval: warning: " << log.string() << ": " << run.recorded.damage << "\n";
   }
-  const eval::RunMetrics metrics = eval::evaluate(recorded.truth, recorded.sources, options.eval);
+  std::vector<std::string> written = {run.metrics_path};
+  written.insert(written.end(), run.tum_paths.begin(), run.tum_paths.end());
 
-  std::vector<std::string> written;
-  const std::string metrics_path = (dir / "metrics.json").string();
-  eval::writeMetricsJson(metrics_path, metrics, options.eval);
-  written.push_back(metrics_path);
-  const std::string truth_path = (dir / "truth.tum").string();
-  eval::writeTum(truth_path, recorded.truth);
-  written.push_back(truth_path);
-  for (const auto& [name, estimates] : recorded.sources) {
-    const eval::PoseTrajectory tracked = eval::trackingTrajectory(estimates);
-    if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
-    const std::string path = (dir / (name + ".tum")).string();
-    eval::writeTum(path, tracked);
-    written.push_back(path);
-  }
-
-  std::cout << eval::formatResultsTable(metrics) << "\n";
+  std::cout << eval::formatResultsTable(run.metrics) << "\n";
   for (std::size_t i = 0; i < written.size(); ++i) {
     std::cout << (i == 0 ? "wrote " : "      ") << written[i] << "\n";
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -427,6 +428,26 @@ PoseTrajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates) 
     trajectory.push_back(StampedPose{e.t_s, e.p_m, e.q.normalized()});
   }
   return trajectory;
+}
+
+RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
+                             const EvalOptions& options) {
+  RunEvaluation run;
+  run.recorded = readRunLog(log_path);
+  run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options);
+  const std::filesystem::path dir(out_dir.empty() ? std::string(".") : out_dir);
+  run.metrics_path = (dir / "metrics.json").string();
+  writeMetricsJson(run.metrics_path, run.metrics, options);
+  run.tum_paths.push_back((dir / "truth.tum").string());
+  writeTum(run.tum_paths.back(), run.recorded.truth);
+  for (const auto& [name, estimates] : run.recorded.sources) {
+    PoseTrajectory tracked = trackingTrajectory(estimates);
+    if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
+    run.tum_paths.push_back((dir / (name + ".tum")).string());
+    writeTum(run.tum_paths.back(), tracked);
+    run.tracked.emplace(name, std::move(tracked));
+  }
+  return run;
 }
 
 void writeMetricsJson(const std::string& path, const RunMetrics& metrics,

@@ -129,6 +129,22 @@ LogTrajectories readRunLog(
 // The TRACKING estimates of a source as a trajectory (for writing <source>.tum).
 PoseTrajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates);
 
+// A run's log evaluated, with what was written for it.
+struct RunEvaluation {
+  LogTrajectories recorded;
+  RunMetrics metrics;
+  std::string metrics_path;
+  // truth.tum, then <source>.tum for every source that ever tracked.
+  std::vector<std::string> tum_paths;
+  // The TRACKING estimates of those sources, by name.
+  std::map<std::string, PoseTrajectory> tracked;
+};
+
+// Reads log_path, evaluates every source and writes metrics.json, truth.tum
+// and <source>.tum into out_dir (nadir run and nadir eval RUN_DIR).
+RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
+                             const EvalOptions& options);
+
 // metrics.json (schema in docs/evaluation.md); NaN is written as null and read
 // back as NaN. Both throw EvalError naming the file.
 void writeMetricsJson(const std::string& path, const RunMetrics& metrics,

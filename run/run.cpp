@@ -132,30 +132,18 @@ RunResult runScenario(const RunOptions& options,
   report(true);
   log.flush();
 
-  const eval::LogTrajectories recorded = eval::readRunLog(result.log_path);
-  const eval::EvalOptions eval_options;
-  result.metrics = eval::evaluate(recorded.truth, recorded.sources, eval_options);
-  eval::writeMetricsJson(result.metrics_path, result.metrics, eval_options);
-  const std::string truth_tum = (out / "truth.tum").string();
-  eval::writeTum(truth_tum, recorded.truth);
-  result.tum_paths.push_back(truth_tum);
-  std::map<std::string, eval::PoseTrajectory> tracked_sources;
-  for (const auto& [name, estimates] : recorded.sources) {
-    for (const eval::SourceEstimate& estimate : estimates) {
-      if (estimate.status == eval::SourceEstimate::kTracking)
-        tracked_sources[name].push_back({estimate.t_s, estimate.p_m, estimate.q});
-    }
-  }
+  const eval::RunEvaluation evaluation =
+      eval::evaluateRunLog(result.log_path, out.string(), eval::EvalOptions{});
+  const eval::LogTrajectories& recorded = evaluation.recorded;
+  result.metrics = evaluation.metrics;
+  result.metrics_path = evaluation.metrics_path;
+  result.tum_paths = evaluation.tum_paths;
   result.picture_paths.push_back((out / "tracks.png").string());
-  writeTrackPlot(result.picture_paths.back(), recorded.truth, tracked_sources,
+  writeTrackPlot(result.picture_paths.back(), recorded.truth, evaluation.tracked,
                  fs::path(options.scenario).stem().string() + ": top view");
   if (!last_image.data.empty()) {
     result.picture_paths.push_back((out / "last_frame.png").string());
     cv::imwrite(result.picture_paths.back(), camera::imageFromMessage(last_image));
-  }
-  for (const auto& [name, tracked] : tracked_sources) {
-    result.tum_paths.push_back((out / (name + ".tum")).string());
-    eval::writeTum(result.tum_paths.back(), tracked);
   }
   result.table = eval::formatResultsTable(result.metrics);
   if (scenario.ppa.enabled && scenario.ppa.target_extraction && !targets_ne_m.empty() &&
