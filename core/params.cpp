@@ -304,10 +304,12 @@ class Formatter final : public ParamVisitor {
     visit_members(inner);
   }
   void groupMap(std::string_view key, std::string_view doc, const GroupMapAccess& access) override {
-    out_ << std::string(static_cast<std::size_t>(indent_), ' ') << key << ":";
-    if (!doc.empty()) out_ << "  # " << doc;
     const std::vector<std::string> names = access.names();
-    out_ << (names.empty() ? " {}\n" : "\n");
+    // An empty map is written {} before the comment, so that it reads back as a map.
+    out_ << std::string(static_cast<std::size_t>(indent_), ' ') << key << ":"
+         << (names.empty() ? " {}" : "");
+    if (!doc.empty()) out_ << "  # " << doc;
+    out_ << "\n";
     for (const std::string& name : names) {
       out_ << std::string(static_cast<std::size_t>(indent_ + 2), ' ') << name << ":\n";
       Formatter inner(out_, indent_ + 4);

@@ -68,6 +68,7 @@ RunResult runScenario(const RunOptions& options,
   std::set<std::string> unrecorded;
   if (!options.record_images) {
     for (const auto& [name, spec] : scenario.allCameras()) unrecorded.insert(spec.channel);
+    unrecorded.insert(scenario.vo_feature.debug_channel);
   }
   core::Subscription recorder =
       bus->subscribe(".*", [&log, &result, &unrecorded](const core::RawMessage& raw) {
@@ -95,7 +96,9 @@ RunResult runScenario(const RunOptions& options,
   std::optional<vo::VoFeatureNode> vo_feature_node;
   if (scenario.vo_feature.enabled) {
     vo::VoFeatureNodeParams params = scenario.vo_feature;
-    params.wall_clock_timing = false;  // byte-identical runs
+    // Byte-identical runs: no wall-clock times, the local BA at fixed key-frames.
+    params.wall_clock_timing = false;
+    params.vo.background_ba = false;
     vo_feature_node.emplace(*bus, params);
   }
   if (scenario.ppa.enabled) {

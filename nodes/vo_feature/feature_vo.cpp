@@ -4,14 +4,21 @@
 #include <opencv2/core/eigen.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
+#include <set>
 #include <unordered_map>
 
 namespace nadir::vo {
 namespace {
 
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 double median(std::vector<double> values) {
   if (values.empty()) return 0.0;
@@ -62,6 +69,12 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
           {.doc = "key-frames in the local bundle adjustment", .min = 2, .max = 100});
   v.field("ba_every_keyframes", &ba_every_keyframes,
           {.doc = "local bundle adjustment every this many key-frames", .min = 1, .max = 1000});
+  v.field("triangulation_keyframes", &triangulation_keyframes,
+          {.doc = "earlier key-frames (widest baseline first) a new key-frame triangulates with",
+           .min = 1,
+           .max = 100});
+  v.field("background_ba", &background_ba,
+          {.doc = "local BA in a background thread (live); off: at its key-frame, byte-identical"});
   v.field("max_hamming", &max_hamming,
           {.doc = "largest Hamming distance of a match", .min = 1, .max = 256});
   v.field("match_ratio", &match_ratio,
@@ -74,12 +87,23 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
           {.doc = "PnP RANSAC inlier threshold, px", .min = 0.1, .max = 100.0});
   v.field("lost_frames_before_reset", &lost_frames_before_reset,
           {.doc = "consecutive lost frames before re-initialising", .min = 1, .max = 100000});
+  v.field("attitude_prior_sigma_deg", &attitude_prior_sigma_deg,
+          {.doc = "standard deviation of the attitude prior in tracking and local BA, deg",
+           .min = 1e-3,
+           .max = 180.0});
+  v.field("reinit_from_range", &reinit_from_range,
+          {.doc = "after a loss, start the new map from the rangefinder's ground plane at once"});
   v.field("scale_tolerance", &scale_tolerance,
-          {.doc = "correct the scale when |map height / measured - 1| exceeds this",
+          {.doc = "correct the scale when |map range / measured - 1| exceeds this",
            .min = 0.0,
            .max = 1.0});
   v.field("scale_gain", &scale_gain,
           {.doc = "share of the scale error corrected per key-frame", .min = 0.0, .max = 1.0});
+  v.field("range_window_px", &range_window_px,
+          {.doc = "the map's range is taken from points within this of the rangefinder ray's "
+                  "image, px",
+           .min = 1.0,
+           .max = 1e4});
 }
 
 FeatureVo::FeatureVo(const FeatureVoParams& params) : params_(params) {
@@ -95,12 +119,96 @@ void FeatureVo::setStartPose(const Eigen::Isometry3d& T_world_body) {
   status_ = VoStatus::kInitializing;
 }
 
+FeatureVo::~FeatureVo() { collectBackgroundBa(true); }
+
 void FeatureVo::resetMap() {
+  ++map_generation_;
   reference_.reset();
-  reference_height_m_.reset();
+  reference_range_m_.reset();
   points_.clear();
   keyframes_.clear();
   keyframes_since_ba_ = 0;
+  keyframe_peak_shared_ = 0;
+}
+
+void FeatureVo::addAttitudePriors(BaProblem& problem,
+                                  const std::vector<const Frame*>& frames) const {
+  // An absolute attitude is a prior on the rotation from a fixed camera with
+  // the world's axes (it has no observations, so it only anchors the priors).
+  int world_axes = -1;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (!frames[k]->q_world_cam_prior) continue;
+    if (world_axes < 0) {
+      world_axes = static_cast<int>(problem.cameras.size());
+      problem.cameras.push_back({Eigen::Isometry3d::Identity(), true});
+    }
+    problem.rotation_priors.push_back({world_axes, static_cast<int>(k),
+                                       *frames[k]->q_world_cam_prior,
+                                       params_.attitude_prior_sigma_deg * kRadPerDeg});
+  }
+}
+
+bool FeatureVo::seedMapFromRange(Frame& cur, const VoFrameInput& in) {
+  if (!in.range_m || !(*in.range_m > 0.0)) return false;
+  const Eigen::Matrix3d& R_world_cam = cur.T_world_cam.linear();
+  const Eigen::Vector3d c = cur.T_world_cam.translation();
+  const double ground_z = c.z() + *in.range_m * (R_world_cam * in.range_ray_cam.normalized()).z();
+  if (!(ground_z > c.z())) return false;
+  // Rays closer to the horizon than this meet the plane too far away to trust.
+  const double max_range_m = 5.0 * *in.range_m;
+  for (std::size_t i = 0; i < cur.features.keypoints.size(); ++i) {
+    const cv::Point2f& px = cur.features.keypoints[i].pt;
+    const Eigen::Vector3d ray_world =
+        R_world_cam *
+        Eigen::Vector3d((px.x - in.K(0, 2)) / in.K(0, 0), (px.y - in.K(1, 2)) / in.K(1, 1), 1.0);
+    if (!(ray_world.z() > 0.0)) continue;
+    const double s = (ground_z - c.z()) / ray_world.z();
+    if (s * ray_world.norm() > max_range_m) continue;
+    MapPoint mp;
+    mp.p_world = c + s * ray_world;
+    mp.descriptor = cur.features.descriptors.row(static_cast<int>(i)).clone();
+    cur.point_of_feature[i] = static_cast<int>(points_.size());
+    points_.push_back(std::move(mp));
+  }
+  if (numMapPoints() < params_.min_init_matches) {
+    resetMap();
+    std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
+    return false;
+  }
+  keyframes_.push_back(cur);
+  return true;
+}
+
+void FeatureVo::compactMap() {
+  // Points no key-frame of the window sees are never matched again; dropping
+  // them keeps memory flat over a long flight. Not while a background BA holds
+  // point indices, and only once most of the vector is dead (amortised O(1)).
+  if (pending_ba_.valid()) return;
+  std::vector<int> new_index(points_.size(), -1);
+  int alive = 0;
+  for (const Frame& kf : keyframes_)
+    for (int id : kf.point_of_feature)
+      if (id >= 0 && new_index[static_cast<std::size_t>(id)] < 0)
+        new_index[static_cast<std::size_t>(id)] = 0;
+  for (std::size_t i = 0; i < points_.size(); ++i)
+    if (new_index[i] == 0 && !points_[i].bad)
+      new_index[i] = alive++;
+    else
+      new_index[i] = -1;
+  if (static_cast<std::size_t>(alive) * 2 > points_.size()) return;
+  std::vector<MapPoint> kept;
+  kept.reserve(static_cast<std::size_t>(alive));
+  for (std::size_t i = 0; i < points_.size(); ++i)
+    if (new_index[i] >= 0) kept.push_back(std::move(points_[i]));
+  points_ = std::move(kept);
+  for (Frame& kf : keyframes_)
+    for (int& id : kf.point_of_feature)
+      if (id >= 0) id = new_index[static_cast<std::size_t>(id)];
+}
+
+void FeatureVo::markTracked(const Frame& frame) {
+  for (std::size_t i = 0; i < frame.point_of_feature.size() && i < last_features_.size(); ++i)
+    last_features_[i].tracked = frame.point_of_feature[i] >= 0;
 }
 
 int FeatureVo::numMapPoints() const {
@@ -139,31 +247,64 @@ VoFrameOutput FeatureVo::process(const VoFrameInput& in) {
   ++frame_index_;
   ++frames_since_good_;
 
+  ++timing_.frames;
+  collectBackgroundBa(false);
+  auto stage_start = Clock::now();
   Frame cur;
+  cur.id = frame_index_;
   cur.features = extractOrb(in.gray, params_.features);
   cur.point_of_feature.assign(cur.features.keypoints.size(), -1);
+  timing_.extract_s += secondsSince(stage_start);
+  last_features_.clear();
+  for (const cv::KeyPoint& kp : cur.features.keypoints)
+    last_features_.push_back({kp.pt, kp.octave, false});
+  stage_start = Clock::now();
 
   Eigen::Isometry3d T_pred = predict(frames_since_good_);
-  if (in.q_world_body_prior) T_pred.linear() = in.q_world_body_prior->matrix() * in.R_body_cam;
+  if (in.q_world_body_prior) {
+    T_pred.linear() = in.q_world_body_prior->matrix() * in.R_body_cam;
+    cur.q_world_cam_prior = Eigen::Quaterniond(T_pred.linear());
+  }
 
-  if (status_ == VoStatus::kInitializing) return initialise(cur, in, T_body_cam, T_pred);
+  if (status_ == VoStatus::kInitializing) {
+    VoFrameOutput out = initialise(cur, in, T_body_cam, T_pred);
+    timing_.track_s += secondsSince(stage_start);
+    if (out.status == VoStatus::kTracking) markTracked(keyframes_.back());
+    return out;
+  }
 
-  if (!track(cur, in, T_pred)) {
+  const bool tracked_ok = track(cur, in, T_pred);
+  timing_.track_s += secondsSince(stage_start);
+  if (!tracked_ok) {
     ++lost_count_;
-    if (lost_count_ >= params_.lost_frames_before_reset) {
+    // A map seeded from the range that the next frame cannot track was seeded
+    // from a bad frame: seed again at once (the same re-initialisation).
+    if (seeded_unconfirmed_ || lost_count_ >= params_.lost_frames_before_reset) {
       // Start again from this frame, anchored where the motion model puts it.
       resetMap();
-      ++resets_;
+      if (!seeded_unconfirmed_) ++resets_;
+      seeded_unconfirmed_ = false;
       status_ = VoStatus::kInitializing;
       cur.T_world_cam = T_pred;
+      if (params_.reinit_from_range && seedMapFromRange(cur, in)) {
+        // The new map's first key-frame is this frame, at the extrapolated pose.
+        T_world_cam_last_ = T_pred;
+        frames_since_good_ = 0;
+        lost_count_ = 0;
+        seeded_unconfirmed_ = true;
+        status_ = VoStatus::kTracking;
+        return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, true);
+      }
       reference_ = std::move(cur);
-      reference_height_m_ = in.height_agl_m;
+      reference_range_m_ = in.range_m;
       reference_frame_index_ = frame_index_;
       return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
     }
     return output(VoStatus::kLost, T_pred, T_body_cam, 0, false);
   }
 
+  markTracked(cur);
+  seeded_unconfirmed_ = false;
   int tracked = 0;
   for (int id : cur.point_of_feature) tracked += id >= 0 ? 1 : 0;
   if (frames_since_good_ == 1) T_delta_ = T_world_cam_last_.inverse() * cur.T_world_cam;
@@ -179,14 +320,23 @@ VoFrameOutput FeatureVo::process(const VoFrameInput& in) {
   int shared = 0;
   for (int id : cur.point_of_feature)
     if (id >= 0 && std::binary_search(kf_ids.begin(), kf_ids.end(), id)) ++shared;
-  const double share =
-      kf_ids.empty() ? 0.0 : static_cast<double>(shared) / static_cast<double>(kf_ids.size());
+  // The share is of the most of them any frame since the key-frame tracked:
+  // some of a key-frame's new points are never found again, and counting them
+  // would call for a key-frame at every frame.
+  keyframe_peak_shared_ = std::max(keyframe_peak_shared_, shared);
+  const double share = keyframe_peak_shared_ == 0 ? 0.0
+                                                  : static_cast<double>(shared) /
+                                                        static_cast<double>(keyframe_peak_shared_);
   const bool new_kf = share < params_.keyframe_min_shared_ratio ||
                       rotationAngleDeg(last_kf.T_world_cam.linear(), cur.T_world_cam.linear()) >
                           params_.keyframe_max_rotation_deg;
   if (new_kf) {
+    keyframe_peak_shared_ = 0;
+    stage_start = Clock::now();
     addKeyframe(cur, in);
     cur.T_world_cam = keyframes_.back().T_world_cam;
+    timing_.mapping_s += secondsSince(stage_start);
+    ++timing_.keyframes;
   }
   T_world_cam_last_ = cur.T_world_cam;
   frames_since_good_ = 0;
@@ -199,7 +349,7 @@ VoFrameOutput FeatureVo::initialise(Frame& cur, const VoFrameInput& in,
   const auto restart_here = [&]() {
     cur.T_world_cam = T_pred;
     reference_ = std::move(cur);
-    reference_height_m_ = in.height_agl_m;
+    reference_range_m_ = in.range_m;
     reference_frame_index_ = frame_index_;
     return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
   };
@@ -221,14 +371,13 @@ VoFrameOutput FeatureVo::initialise(Frame& cur, const VoFrameInput& in,
   const TwoViewResult r = initialiseTwoView(px1, px2, in.K, params_.two_view);
   if (!r.ok) return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
 
-  // Metric scale: the reference camera's height over the ground from the map.
-  const Eigen::Vector3d down_in_ref =
-      ref.T_world_cam.linear().transpose() * Eigen::Vector3d::UnitZ();
-  std::vector<double> heights;
-  for (const Eigen::Vector3d& p : r.points_1) heights.push_back(p.dot(down_in_ref));
-  const double map_height = median(heights);
-  if (!(map_height > 0.0)) return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
-  const double scale = reference_height_m_ ? *reference_height_m_ / map_height : 1.0;
+  // Metric scale: the reference camera's range along the rangefinder's ray, from the map.
+  double scale = 1.0;
+  if (reference_range_m_) {
+    const std::optional<double> map_range = mapRange(r.points_1, in);
+    if (!map_range) return output(VoStatus::kInitializing, T_pred, T_body_cam, 0, false);
+    scale = *reference_range_m_ / *map_range;
+  }
 
   Eigen::Isometry3d T_cur_ref = Eigen::Isometry3d::Identity();
   T_cur_ref.linear() = r.R_21;
@@ -331,6 +480,7 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
   BaProblem problem;
   problem.K = baIntrinsics(in.K);
   problem.cameras.push_back({T_cw.inverse(), false});
+  addAttitudePriors(problem, {&cur});
   for (int i : inliers) {
     const cv::DMatch& m = matches[static_cast<std::size_t>(i)];
     problem.points.push_back({Eigen::Vector3d(object[static_cast<std::size_t>(i)].x,
@@ -355,29 +505,45 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
   return tracked;
 }
 
-double FeatureVo::medianHeight(const Frame& kf) const {
-  std::vector<double> heights;
-  const Eigen::Vector3d c = kf.T_world_cam.translation();
+std::optional<double> FeatureVo::mapRange(const std::vector<Eigen::Vector3d>& p_cam,
+                                          const VoFrameInput& in) const {
+  const Eigen::Vector3d& ray = in.range_ray_cam;
+  if (!(ray.z() > 1e-6)) return std::nullopt;
+  const Eigen::Vector2d ray_px = project(in.K, ray);
+  // The window grows until it holds enough points (a sparse patch under the ray).
+  for (double window_px = params_.range_window_px; window_px <= 4.0 * params_.range_window_px;
+       window_px *= 2.0) {
+    std::vector<double> ranges;
+    for (const Eigen::Vector3d& p : p_cam)
+      if (p.z() > 0.0 && (project(in.K, p) - ray_px).norm() <= window_px)
+        ranges.push_back(p.dot(ray));
+    if (ranges.size() >= 10) return median(ranges);
+  }
+  return std::nullopt;
+}
+
+std::optional<double> FeatureVo::mapRange(const Frame& kf, const VoFrameInput& in) const {
+  const Eigen::Isometry3d T_cam_world = kf.T_world_cam.inverse();
+  std::vector<Eigen::Vector3d> p_cam;
   for (int id : kf.point_of_feature)
     if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad)
-      heights.push_back(points_[static_cast<std::size_t>(id)].p_world.z() - c.z());
-  return median(heights);
+      p_cam.push_back(T_cam_world * points_[static_cast<std::size_t>(id)].p_world);
+  return mapRange(p_cam, in);
 }
 
 void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   Frame kf = cur;
-  triangulateWithPrevious(kf, keyframes_.back(), in.K);
+  triangulateNewPoints(kf, in.K);
   keyframes_.push_back(std::move(kf));
   while (static_cast<int>(keyframes_.size()) > params_.local_window) keyframes_.pop_front();
-  if (++keyframes_since_ba_ >= params_.ba_every_keyframes) {
-    localBundleAdjust(in.K);
+  compactMap();
+  if (++keyframes_since_ba_ >= params_.ba_every_keyframes && localBundleAdjust(in.K))
     keyframes_since_ba_ = 0;
-  }
-  if (!in.height_agl_m) return;
+  if (!in.range_m) return;
   const Frame& newest = keyframes_.back();
-  const double map_height = medianHeight(newest);
-  if (!(map_height > 0.0)) return;
-  last_scale_ratio_ = map_height / *in.height_agl_m;
+  const std::optional<double> map_range = mapRange(newest, in);
+  if (!map_range || !(*map_range > 0.0)) return;
+  last_scale_ratio_ = *map_range / *in.range_m;
   if (std::abs(last_scale_ratio_ - 1.0) <= params_.scale_tolerance) return;
   // Scale the new key-frame's points about its centre: its pose stays, the
   // motion measured from here on comes out closer to metric.
@@ -391,7 +557,7 @@ void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   T_delta_.translation() *= factor;
 }
 
-void FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K) {
+int FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K) {
   const auto subset = [](const Frame& f, std::vector<int>& index) {
     Features out;
     std::vector<cv::Mat> rows;
@@ -407,21 +573,30 @@ void FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv:
   std::vector<int> index_prev, index_new;
   const Features a = subset(kf_prev, index_prev);
   const Features b = subset(kf_new, index_new);
-  if (a.keypoints.empty() || b.keypoints.empty()) return;
+  if (a.keypoints.empty() || b.keypoints.empty()) return 0;
 
-  // Predict through the previous key-frame's median depth (the ground is nearly a plane).
-  std::vector<double> depths;
-  const Eigen::Isometry3d T_prev_world = kf_prev.T_world_cam.inverse();
+  // Predict through the ground under the previous key-frame: the horizontal
+  // plane at the median height of its points (the ground is nearly a plane;
+  // a plane, unlike one depth, also holds for an oblique view in a banked turn).
+  std::vector<double> ground_z;
   for (int id : kf_prev.point_of_feature)
     if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad)
-      depths.push_back((T_prev_world * points_[static_cast<std::size_t>(id)].p_world).z());
-  const double depth = median(depths);
-  if (!(depth > 0.0)) return;
-  const Eigen::Isometry3d T_new_prev = kf_new.T_world_cam.inverse() * kf_prev.T_world_cam;
+      ground_z.push_back(points_[static_cast<std::size_t>(id)].p_world.z());
+  if (ground_z.empty()) return 0;
+  const double plane_z = median(ground_z);
+  const Eigen::Vector3d c_prev = kf_prev.T_world_cam.translation();
+  if (!(plane_z > c_prev.z())) return 0;
+  const Eigen::Isometry3d T_new_world = kf_new.T_world_cam.inverse();
   std::vector<cv::Point2f> predicted;
   for (const cv::KeyPoint& kp : a.keypoints) {
-    const Eigen::Vector3d ray((kp.pt.x - K(0, 2)) / K(0, 0), (kp.pt.y - K(1, 2)) / K(1, 1), 1.0);
-    const Eigen::Vector3d p_new = T_new_prev * (depth * ray);
+    const Eigen::Vector3d ray_world =
+        kf_prev.T_world_cam.linear() *
+        Eigen::Vector3d((kp.pt.x - K(0, 2)) / K(0, 0), (kp.pt.y - K(1, 2)) / K(1, 1), 1.0);
+    const Eigen::Vector3d p_new =
+        ray_world.z() > 1e-6
+            ? Eigen::Vector3d(T_new_world *
+                              (c_prev + (plane_z - c_prev.z()) / ray_world.z() * ray_world))
+            : Eigen::Vector3d(0.0, 0.0, -1.0);
     if (p_new.z() <= 0.0) {
       predicted.emplace_back(-1e6f, -1e6f);
       continue;
@@ -434,9 +609,11 @@ void FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv:
                     static_cast<float>(params_.match_ratio));
   matches = filterByOrientation(a, b, matches);
 
+  const Eigen::Isometry3d T_new_prev = T_new_world * kf_prev.T_world_cam;
   TriangulationChecks checks;
   checks.min_parallax_deg = std::max(1.0, params_.two_view.min_point_parallax_deg);
   checks.max_reprojection_error_px = params_.two_view.max_reprojection_error_px;
+  int added = 0;
   for (const cv::DMatch& m : matches) {
     const Triangulation t = triangulate(a.keypoints[static_cast<std::size_t>(m.queryIdx)].pt,
                                         b.keypoints[static_cast<std::size_t>(m.trainIdx)].pt,
@@ -451,54 +628,134 @@ void FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv:
     kf_prev.point_of_feature[static_cast<std::size_t>(
         index_prev[static_cast<std::size_t>(m.queryIdx)])] = id;
     kf_new.point_of_feature[static_cast<std::size_t>(i_new)] = id;
+    ++added;
   }
+  return added;
 }
 
-void FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
-  const int n = static_cast<int>(keyframes_.size());
-  if (n < 2) return;
+void FeatureVo::triangulateNewPoints(Frame& kf_new, const cv::Matx33d& K) {
+  // Pair the new key-frame with the earlier ones that share its view, widest
+  // baseline first: in a turn, key-frames come every few degrees of rotation
+  // with a baseline too short for the parallax the neighbour alone would give.
+  std::set<int> new_ids;
+  for (int id : kf_new.point_of_feature)
+    if (id >= 0) new_ids.insert(id);
+  std::vector<std::pair<double, std::size_t>> candidates;
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    int shared = 0;
+    for (int id : keyframes_[k].point_of_feature)
+      if (id >= 0 && new_ids.count(id) != 0) ++shared;
+    if (shared < params_.min_tracked_points && k + 1 != keyframes_.size()) continue;
+    const double baseline_m =
+        (keyframes_[k].T_world_cam.translation() - kf_new.T_world_cam.translation()).norm();
+    candidates.emplace_back(-baseline_m, k);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  const std::size_t pairs =
+      std::min(candidates.size(), static_cast<std::size_t>(params_.triangulation_keyframes));
+  for (std::size_t c = 0; c < pairs; ++c)
+    triangulateWithPrevious(kf_new, keyframes_[candidates[c].second], K);
+}
+
+struct FeatureVo::LocalBaJob {
+  struct Ref {
+    std::int64_t keyframe_id;
+    std::size_t feature;
+    int point_id;
+  };
+  std::int64_t map_generation = 0;
   BaProblem problem;
+  BaResult result;
+  std::vector<std::int64_t> keyframe_ids;      // of the problem's first cameras
+  std::vector<int> point_ids;                  // of the problem's points
+  std::vector<Eigen::Vector3d> points_before;  // their positions when the BA started
+  std::vector<Ref> refs;                       // of the problem's observations
+};
+
+bool FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
+  const int n = static_cast<int>(keyframes_.size());
+  if (n < 2) return false;
+  if (params_.background_ba && pending_ba_.valid()) return false;
+  auto job = std::make_unique<LocalBaJob>();
+  job->map_generation = map_generation_;
+  BaProblem& problem = job->problem;
   problem.K = baIntrinsics(K);
-  // Only the oldest key-frame is fixed: the scale stays free, so the height
+  // Only the oldest key-frame is fixed: the scale stays free, so the range
   // correction of the newest key-frame's points spreads instead of being pulled back.
   const int fixed = std::min(1, n - 1);
-  for (int k = 0; k < n; ++k)
-    problem.cameras.push_back({keyframes_[static_cast<std::size_t>(k)].T_world_cam, k < fixed});
+  for (int k = 0; k < n; ++k) {
+    const Frame& kf = keyframes_[static_cast<std::size_t>(k)];
+    problem.cameras.push_back({kf.T_world_cam, k < fixed});
+    job->keyframe_ids.push_back(kf.id);
+  }
   std::unordered_map<int, int> ba_index;
-  std::vector<int> point_ids;
-  struct Ref {
-    int kf;
-    std::size_t feature;
-  };
-  std::vector<Ref> refs;
   for (int k = 0; k < n; ++k) {
     const Frame& kf = keyframes_[static_cast<std::size_t>(k)];
     for (std::size_t i = 0; i < kf.point_of_feature.size(); ++i) {
       const int id = kf.point_of_feature[i];
       if (id < 0 || points_[static_cast<std::size_t>(id)].bad) continue;
-      auto [it, inserted] = ba_index.emplace(id, static_cast<int>(point_ids.size()));
+      auto [it, inserted] = ba_index.emplace(id, static_cast<int>(job->point_ids.size()));
       if (inserted) {
-        point_ids.push_back(id);
+        job->point_ids.push_back(id);
         problem.points.push_back({points_[static_cast<std::size_t>(id)].p_world, false});
       }
       const cv::KeyPoint& kp = kf.features.keypoints[i];
       problem.observations.push_back(
           {k, it->second, Eigen::Vector2d(kp.pt.x, kp.pt.y),
            std::pow(static_cast<double>(params_.features.scale_factor), kp.octave)});
-      refs.push_back({k, i});
+      job->refs.push_back({kf.id, i, id});
     }
   }
+  std::vector<const Frame*> frames;
+  for (const Frame& kf : keyframes_) frames.push_back(&kf);
+  addAttitudePriors(problem, frames);
   BundleAdjustmentParams ba = params_.ba;
   ba.num_threads = 1;
-  const BaResult result = bundleAdjust(problem, ba);
-  for (int k = 0; k < n; ++k)
-    keyframes_[static_cast<std::size_t>(k)].T_world_cam =
-        problem.cameras[static_cast<std::size_t>(k)].T_world_cam;
-  for (std::size_t j = 0; j < point_ids.size(); ++j)
-    points_[static_cast<std::size_t>(point_ids[j])].p_world = problem.points[j].p_world_m;
-  for (std::size_t o = 0; o < refs.size(); ++o)
-    if (result.outlier[o])
-      keyframes_[static_cast<std::size_t>(refs[o].kf)].point_of_feature[refs[o].feature] = -1;
+  for (const BaPoint& point : problem.points) job->points_before.push_back(point.p_world_m);
+  if (!params_.background_ba) {
+    job->result = bundleAdjust(problem, ba);
+    applyLocalBa(*job);
+    return true;
+  }
+  pending_ba_ = std::async(std::launch::async, [ba, job = std::move(job)]() mutable {
+    job->result = bundleAdjust(job->problem, ba);
+    return std::move(job);
+  });
+  return true;
+}
+
+void FeatureVo::collectBackgroundBa(bool wait) {
+  if (!pending_ba_.valid()) return;
+  if (!wait && pending_ba_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  const std::unique_ptr<LocalBaJob> job = pending_ba_.get();
+  applyLocalBa(*job);
+}
+
+void FeatureVo::applyLocalBa(const LocalBaJob& job) {
+  // A map dropped since the BA started is gone; key-frames that left the
+  // window since keep their place (the deque holds them by age).
+  if (job.map_generation != map_generation_) return;
+  std::unordered_map<std::int64_t, Frame*> by_id;
+  for (Frame& kf : keyframes_) by_id.emplace(kf.id, &kf);
+  for (std::size_t k = 0; k < job.keyframe_ids.size(); ++k) {
+    const auto it = by_id.find(job.keyframe_ids[k]);
+    if (it != by_id.end()) it->second->T_world_cam = job.problem.cameras[k].T_world_cam;
+  }
+  // In the background, points take the BA's correction, not its positions: a
+  // range correction may have moved them since the BA started.
+  for (std::size_t j = 0; j < job.point_ids.size(); ++j) {
+    Eigen::Vector3d& p = points_[static_cast<std::size_t>(job.point_ids[j])].p_world;
+    p = params_.background_ba
+            ? Eigen::Vector3d(p + job.problem.points[j].p_world_m - job.points_before[j])
+            : job.problem.points[j].p_world_m;
+  }
+  for (std::size_t o = 0; o < job.refs.size(); ++o) {
+    if (!job.result.outlier[o]) continue;
+    const auto it = by_id.find(job.refs[o].keyframe_id);
+    if (it == by_id.end()) continue;
+    int& point = it->second->point_of_feature[job.refs[o].feature];
+    if (point == job.refs[o].point_id) point = -1;
+  }
 }
 
 }  // namespace nadir::vo

@@ -3,54 +3,68 @@
 // tracking and local mapping, loop closing off): plain structs in and out, no
 // LCM.
 //
-// Initialisation: the first frame after setStartPose (or after a reset) is the
-// reference; later frames are matched to it by brute force (+ the rotation
-// consistency check) until initialiseTwoView succeeds. The reference camera's
-// world pose is T_world_body_start * T_body_cam: the VO assumes the vehicle is
-// at the start pose when the reference frame is taken (nadir anchors every VO
-// at the truth of its first frame). Metric scale: the reference camera's height
-// above the (nearly planar) ground is the median depth of the triangulated
-// points along the world-down direction; the map is scaled so it equals
-// height_agl_m of the reference frame. Without a height the two-view
-// translation keeps unit norm (the map is then up to an unknown scale). While
-// initialising, the published pose is the reference's pose.
+// Initialisation: the first frame after setStartPose is the reference; later
+// frames are matched to it by brute force (+ the rotation consistency check)
+// until initialiseTwoView succeeds. The reference camera's world pose is
+// T_world_body_start * T_body_cam: the VO assumes the vehicle is at the start
+// pose when the reference frame is taken (nadir anchors every VO at the truth
+// of its first frame). Metric scale: the map's range along the rangefinder's
+// ray (the median distance along the ray of the points seen within
+// range_window_px of the ray's image; the window grows to 4x if too few) is
+// set to the measured range. Without a range the two-view translation keeps
+// unit norm (the map is then up to an unknown scale). While initialising, the
+// published pose is the reference's pose.
 //
 // Tracking: a constant-velocity model (or the attitude prior's rotation with
 // the model's position) predicts the camera; the map points of the local
 // key-frames are projected into the frame and matched within a window around
 // their predictions (a wider window when too few match), the pose is found by
 // cv::solvePnPRansac and refined by a motion-only bundle adjustment (points
-// fixed, Huber loss, outliers dropped). Fewer than min_tracked_points inliers
-// after the wide window: LOST for this frame, the published pose is the motion
-// model's extrapolation, and the next frames try again from the extrapolation.
-// After lost_frames_before_reset consecutive lost frames the map is dropped
-// and the VO re-initialises with the reference anchored at the extrapolated
-// pose (same world frame, scale from the height): the published pose continues
-// from the extrapolation, it does not jump back.
+// fixed, Huber loss, outliers dropped; with the attitude prior, a prior on the
+// camera's attitude of attitude_prior_sigma_deg). Fewer than min_tracked_points
+// inliers after the wide window: LOST for this frame, the published pose is
+// the motion model's extrapolation, and the next frames try again from the
+// extrapolation.
 //
-// Key-frames: a frame becomes one when the share of the last key-frame's map
-// points it tracks falls below keyframe_min_shared_ratio, or its rotation from
-// the last key-frame exceeds keyframe_max_rotation_deg. Its unmatched features
-// are matched to the previous key-frame's unmatched ones (window around the
-// position predicted through the previous key-frame's median depth) and
-// triangulated with the parallax and reprojection checks; then a local bundle
-// adjustment (single thread: deterministic) refines the last local_window
-// key-frames (the oldest one fixed: it holds the position and attitude gauge;
-// the scale is left to the points and the height correction below, fixing two
-// held the map's scale against it) and their points, every ba_every_keyframes
-// key-frames.
+// Re-initialisation: after lost_frames_before_reset consecutive lost frames
+// the map is dropped (num_resets counts) and a new one starts in the same
+// world frame at the extrapolated pose, so the published pose continues from
+// the extrapolation and never jumps back. With a range (reinit_from_range) the
+// new map is made at once from this frame: every feature's ray is met with the
+// level plane through the ground point the rangefinder sees; if the next frame
+// cannot track it, it is made again from that frame. Without a range, the
+// frame becomes a two-view reference as at the start.
 //
-// Scale upkeep: at each key-frame with a height, the map's height (median
-// depth of the key-frame's points along the down direction) is compared with
-// height_agl_m; their ratio is reported (lastScaleRatio). When it is off by
-// more than scale_tolerance, the points the new key-frame sees are scaled
-// about its camera centre by 1 + scale_gain * (ratio - 1), and so is the
-// motion model's translation: the published pose does not move, the following
-// motion comes out closer to metric, and the next local BA spreads it. A gain
-// below 1 keeps a single noisy height from bending the map.
+// Key-frames: a frame becomes one when the last key-frame's map points it
+// tracks fall below keyframe_min_shared_ratio of the most any frame since that
+// key-frame tracked, or its rotation from the last key-frame exceeds
+// keyframe_max_rotation_deg (distance alone fails in turns). Its unmatched
+// features are matched to the unmatched ones of up to triangulation_keyframes
+// earlier key-frames that share its view, widest baseline first (windows around
+// the positions predicted through the level plane of the earlier key-frame's
+// points: a plane, unlike a depth, holds for an oblique view), and triangulated
+// with the parallax and reprojection checks. Then a local bundle adjustment
+// refines the last local_window key-frames (the oldest one fixed: it holds the
+// position and attitude gauge; the scale is left to the points and the range
+// correction below) and their points, with the attitude priors of the
+// key-frames that have one, every ba_every_keyframes key-frames. Live
+// (background_ba) it runs in a thread and its result is taken in at the first
+// frame after it finishes; in nadir run it runs at its key-frame so that runs
+// are byte-identical.
+//
+// Scale upkeep: at each key-frame with a range, the map's range along the ray
+// is compared with the measured one; their ratio is reported
+// (lastScaleRatio). When it is off by more than scale_tolerance, the points
+// the new key-frame sees are scaled about its camera centre by
+// 1 + scale_gain * (1 / ratio - 1), and so is the motion model's translation:
+// the published pose does not move, the following motion comes out closer to
+// metric, and the next local BA spreads it. A gain below 1 keeps a single noisy
+// range from bending the map.
 
 #include <cstdint>
 #include <deque>
+#include <future>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -60,6 +74,7 @@
 
 #include "core/params.h"
 #include "nodes/vo_feature/bundle_adjustment.h"
+#include "nodes/vo_feature/debug_image.h"
 #include "nodes/vo_feature/features.h"
 #include "nodes/vo_feature/two_view.h"
 
@@ -74,13 +89,21 @@ struct FeatureVoParams {
   // Fewer PnP inliers than this: the frame is lost.
   int min_tracked_points = 30;
   // New key-frame when the tracked share of the last key-frame's points falls below this.
-  double keyframe_min_shared_ratio = 0.6;
+  double keyframe_min_shared_ratio = 0.8;
   // New key-frame when the rotation since the last key-frame exceeds this, deg.
   double keyframe_max_rotation_deg = 5.0;
   // Key-frames in the local bundle adjustment.
   int local_window = 8;
+  // A new key-frame triangulates with this many earlier key-frames sharing its
+  // view, widest baseline first.
+  int triangulation_keyframes = 1;
   // Local bundle adjustment every this many key-frames.
   int ba_every_keyframes = 1;
+  // Live: the local bundle adjustment runs in a background thread and its
+  // result is taken in at the first frame after it finishes (a key-frame that
+  // comes while one runs waits for the next). Off (nadir run): at its key-frame,
+  // so that runs are byte-identical.
+  bool background_ba = true;
   // Matching: Hamming distance limit and ratio test.
   int max_hamming = 64;
   double match_ratio = 0.9;
@@ -91,9 +114,19 @@ struct FeatureVoParams {
   double pnp_reprojection_px = 3.0;
   // Consecutive lost frames before the map is dropped and the VO re-initialises.
   int lost_frames_before_reset = 5;
-  // Scale upkeep: correct when |height ratio - 1| exceeds this, by this share.
-  double scale_tolerance = 0.01;
+  // Standard deviation of the attitude prior (the flight controller's attitude)
+  // in tracking and in the local bundle adjustment, deg.
+  double attitude_prior_sigma_deg = 0.5;
+  // After a loss, with a range: start the new map at once from the ground the
+  // rangefinder sees (every feature's ray met with the level plane through the
+  // range's ground point), not by two-view initialisation.
+  bool reinit_from_range = true;
+  // Scale upkeep: correct when |range ratio - 1| exceeds this, by this share.
+  double scale_tolerance = 0.002;
   double scale_gain = 0.5;
+  // The map's range is taken from the points seen within this many pixels of
+  // the rangefinder ray's image.
+  double range_window_px = 120.0;
 
   void visit(core::ParamVisitor& v);
 };
@@ -103,11 +136,24 @@ struct VoFrameInput {
   cv::Mat gray;  // 8-bit, undistorted
   cv::Matx33d K = cv::Matx33d::eye();
   Eigen::Matrix3d R_body_cam = Eigen::Matrix3d::Identity();
-  std::optional<double> height_agl_m;  // from the rangefinder, for the metric scale
+  // The rangefinder, for the metric scale: its range along its ray (a unit
+  // vector in the camera frame), m.
+  std::optional<double> range_m;
+  Eigen::Vector3d range_ray_cam = Eigen::Vector3d::UnitZ();
   std::optional<Eigen::Quaterniond> q_world_body_prior;  // optional attitude prior
 };
 
 enum class VoStatus { kInitializing, kTracking, kLost };
+
+// Wall-clock seconds spent in each stage, summed over the frames processed
+// (diagnostics only: nothing the VO computes depends on them).
+struct FeatureVoTiming {
+  double extract_s = 0;  // ORB extraction
+  double track_s = 0;    // initialisation or tracking (matching, PnP, motion-only BA)
+  double mapping_s = 0;  // key-frames: triangulation, local BA, scale upkeep
+  std::int64_t frames = 0;
+  std::int64_t keyframes = 0;
+};
 
 struct VoFrameOutput {
   VoStatus status = VoStatus::kInitializing;
@@ -121,6 +167,7 @@ class FeatureVo {
  public:
   // Throws std::invalid_argument on bad params.
   explicit FeatureVo(const FeatureVoParams& params);
+  ~FeatureVo();  // waits for a background bundle adjustment
 
   // The pose of the body when the VO starts: the world frame the estimates are
   // published in. Drops any map and starts initialising from the next frame.
@@ -128,11 +175,16 @@ class FeatureVo {
 
   VoFrameOutput process(const VoFrameInput& frame);
 
-  // Diagnostics: map height / measured height at the last key-frame with a
-  // height (1 before), key-frames and map points alive.
+  // Diagnostics: map range / measured range at the last key-frame with a
+  // range (1 before), key-frames in the window and map points alive.
   double lastScaleRatio() const { return last_scale_ratio_; }
   int numKeyframes() const { return static_cast<int>(keyframes_.size()); }
   int numMapPoints() const;
+  // Points held in memory, alive or not (for tests of the memory bound).
+  std::size_t storedMapPoints() const { return points_.size(); }
+  const FeatureVoTiming& timing() const { return timing_; }
+  // The last frame's features, each marked if it was matched to the map (the debug image).
+  const std::vector<DebugFeature>& lastFrameFeatures() const { return last_features_; }
 
  private:
   struct MapPoint {
@@ -142,11 +194,18 @@ class FeatureVo {
   };
   struct Frame {
     Features features;
+    std::int64_t id = 0;                // the frame's index
     std::vector<int> point_of_feature;  // map point index per feature, -1: none
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+    // The flight controller's attitude of the camera, when given (attitude prior).
+    std::optional<Eigen::Quaterniond> q_world_cam_prior;
   };
 
   void resetMap();
+  void markTracked(const Frame& frame);
+  void compactMap();
+  void addAttitudePriors(BaProblem& problem, const std::vector<const Frame*>& frames) const;
+  bool seedMapFromRange(Frame& cur, const VoFrameInput& in);
   VoFrameOutput initialise(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_body_cam,
                            const Eigen::Isometry3d& T_pred);
   bool track(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred);
@@ -155,9 +214,18 @@ class FeatureVo {
   void addKeyframe(const Frame& cur, const VoFrameInput& in);
   VoFrameOutput output(VoStatus status, const Eigen::Isometry3d& T_world_cam,
                        const Eigen::Isometry3d& T_body_cam, int tracked, bool keyframe) const;
-  void triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K);
-  void localBundleAdjust(const cv::Matx33d& K);
-  double medianHeight(const Frame& kf) const;
+  // Returns the points added.
+  int triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K);
+  void triangulateNewPoints(Frame& kf_new, const cv::Matx33d& K);
+  struct LocalBaJob;
+  // Starts (or, not in the background, runs) a local BA; false if none started.
+  bool localBundleAdjust(const cv::Matx33d& K);
+  void applyLocalBa(const LocalBaJob& job);
+  void collectBackgroundBa(bool wait);
+  // The map's range along the rangefinder's ray from a camera (see the top).
+  std::optional<double> mapRange(const std::vector<Eigen::Vector3d>& p_cam,
+                                 const VoFrameInput& in) const;
+  std::optional<double> mapRange(const Frame& kf, const VoFrameInput& in) const;
   Eigen::Isometry3d predict(int steps) const;
 
   FeatureVoParams params_;
@@ -166,7 +234,7 @@ class FeatureVo {
 
   // Initialisation: the reference frame and its anchored camera pose.
   std::optional<Frame> reference_;
-  std::optional<double> reference_height_m_;
+  std::optional<double> reference_range_m_;
   int reference_frame_index_ = 0;
   int frame_index_ = 0;
   bool start_pending_ = true;
@@ -174,6 +242,8 @@ class FeatureVo {
   std::vector<MapPoint> points_;
   std::deque<Frame> keyframes_;
   int keyframes_since_ba_ = 0;
+  // The most of the last key-frame's points a frame since it has tracked.
+  int keyframe_peak_shared_ = 0;
 
   // Motion model: the last good camera pose, frames since it, and the velocity.
   Eigen::Isometry3d T_world_cam_last_ = Eigen::Isometry3d::Identity();
@@ -181,8 +251,15 @@ class FeatureVo {
   Eigen::Isometry3d T_delta_ = Eigen::Isometry3d::Identity();
   int frames_since_good_ = 1;
   int lost_count_ = 0;
+  // The map was seeded from the range and no frame has tracked it yet.
+  bool seeded_unconfirmed_ = false;
   int resets_ = 0;
   double last_scale_ratio_ = 1.0;
+  FeatureVoTiming timing_;
+  std::vector<DebugFeature> last_features_;
+  // Counts map resets: a background BA of an earlier map is dropped.
+  std::int64_t map_generation_ = 0;
+  std::future<std::unique_ptr<LocalBaJob>> pending_ba_;
 };
 
 }  // namespace nadir::vo

@@ -2,15 +2,24 @@
 // ORB features for the feature-based monocular VO (seed 002, ORB-SLAM2), and
 // the descriptor matching the tracker and the initialiser use.
 //
-// Extraction follows ORB-SLAM's ORBextractor: a scale pyramid whose levels get
-// a geometrically decreasing share of the wanted features; each level is cut
-// into a grid of cells, FAST runs per cell with fast_threshold and again with
-// min_fast_threshold where a cell found fewer corners than its share (weakly
-// textured ground still gets features), and every cell keeps its strongest
-// corners up to its share; what the poor cells leave unused goes to the
-// strongest remaining corners of the level. Orientations are the intensity
-// centroid angles; the descriptors are OpenCV's ORB (cv::ORB::compute).
-// Keypoints are in level-0 pixels, octave = pyramid level.
+// Extraction follows ORB-SLAM's ORBextractor: a scale pyramid (each level
+// resized bilinearly from the one before) whose levels get a geometrically
+// decreasing share of the wanted features; each level is cut into a grid of
+// cells, and every cell keeps its strongest FAST-9 corners up to its share:
+// the corners FAST finds at fast_threshold, or at min_fast_threshold where a
+// cell has fewer than its share (weakly textured ground still gets features).
+// What the poor cells leave unused goes to the strongest remaining corners of
+// the level (those at fast_threshold, and the poor cells' at
+// min_fast_threshold). FAST is nadir's own SIMD version with the same corners,
+// scores (response) and non-maximum suppression as cv::FAST on the whole level;
+// each cell lowers its threshold step by step from well above fast_threshold
+// and stops once it has its share, so most pixels are never scored.
+// Orientations are the intensity centroid angles. Descriptors are ORB's kind:
+// 256 tests comparing two pixels of the level blurred with a 7 x 7, sigma 2
+// Gaussian, at the points of a fixed pattern (learned as ORB's rBRIEF, see
+// features.cpp) turned by the keypoint angle.
+// Keypoints are in level-0 pixels, octave = pyramid level, size = the 31 px
+// patch at that level, response = FAST score.
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
@@ -39,7 +48,7 @@ struct FeatureParams {
 
 struct Features {
   std::vector<cv::KeyPoint> keypoints;  // level-0 pixels; octave = level; angle in deg
-  cv::Mat descriptors;                  // one 32-byte ORB descriptor (CV_8U) per keypoint
+  cv::Mat descriptors;                  // one 32-byte descriptor (CV_8U row) per keypoint
 };
 
 // ORB features of an 8-bit grey image, spread over the grid on every pyramid

@@ -3,6 +3,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <sstream>
+
 #include "core/frames.h"
 #include "nadir/vo_estimate_t.hpp"
 #include "nodes/camera/camera_messages.h"
@@ -12,11 +14,18 @@ void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the feature VO in this scenario"});
   v.field("image_channel", &image_channel, {.doc = "the camera's images (gray or RGB)"});
   v.field("info_channel", &info_channel, {.doc = "its camera_info_t (intrinsics, mount)"});
-  v.field("range_channel", &range_channel, {.doc = "range_t: height above ground, for scale"});
+  v.field("range_channel", &range_channel,
+          {.doc = "range_t: the rangefinder along the body's down axis, for the scale"});
   v.field("attitude_channel", &attitude_channel,
           {.doc = "attitude_t: the flight controller's attitude (for attitude_prior)"});
   v.field("truth_channel", &truth_channel, {.doc = "pose_t read once: the start pose"});
   v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
+  v.field("debug_channel", &debug_channel,
+          {.doc = "image_t out: the frame with the tracked features (thesis figure 21)"});
+  v.field("debug_every_frames", &debug_every_frames,
+          {.doc = "a debug image every this many frames (0: none)", .min = 0, .max = 1000000});
+  v.field("debug_jpeg_quality", &debug_jpeg_quality,
+          {.doc = "JPEG quality of the debug image", .min = 1, .max = 100});
   v.field("attitude_prior", &attitude_prior,
           {.doc = "use the flight controller's attitude as each frame's rotation prior"});
   v.field("wall_clock_timing", &wall_clock_timing,
@@ -96,11 +105,9 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
   input.gray = gray;
   input.K = K;
   input.R_body_cam = core::quaternionFromWire(info_->orientation_body_cam).toRotationMatrix();
-  if (const auto range_m = inputs_.validRange_m()) {
-    // Height from the slant range along the body-down ray (level: the range itself).
-    const double down = attitude ? attitude->toRotationMatrix()(2, 2) : 1.0;
-    input.height_agl_m = *range_m * std::max(down, 0.0);
-  }
+  // The rangefinder looks along the body's down axis.
+  input.range_m = inputs_.validRange_m();
+  input.range_ray_cam = input.R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
   if (params_.attitude_prior) input.q_world_body_prior = attitude;
 
   const auto started = std::chrono::steady_clock::now();
@@ -125,6 +132,26 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
   estimate.num_resets = out.resets;
   estimate.processing_time_s = params_.wall_clock_timing ? elapsed_s : 0.0;
   core::publish(bus_, params_.pose_channel, estimate);
+  if (params_.debug_every_frames > 0 &&
+      (frames_ - 1) % static_cast<std::uint64_t>(params_.debug_every_frames) == 0)
+    publishDebugImage(gray, image.utime, out);
+}
+
+void VoFeatureNode::publishDebugImage(const cv::Mat& frame, std::int64_t utime,
+                                      const VoFrameOutput& out) {
+  const char* status = out.status == VoStatus::kTracking ? "TRACKING"
+                       : out.status == VoStatus::kLost   ? "LOST"
+                                                         : "INITIALIZING";
+  const std::vector<DebugFeature>& features = vo_.lastFrameFeatures();
+  std::ostringstream text;
+  text << status << "  " << out.tracked_points << " matched of " << features.size()
+       << " features  map " << vo_.numMapPoints() << " points  key-frames "
+       << vo_.timing().keyframes << "  resets " << out.resets;
+  render::RenderedImage rendered;
+  rendered.utime = utime;
+  rendered.image = drawDebugImage(frame, features, text.str());
+  core::publish(bus_, params_.debug_channel,
+                camera::toImageMessage(rendered, params_.debug_jpeg_quality));
 }
 
 }  // namespace nadir::vo

@@ -1,7 +1,7 @@
 #pragma once
 // nadir-vo-feature's work on a bus, the same in the live node and in `nadir
 // run`: the downward camera's frames go through FeatureVo with the
-// rangefinder's height (and optionally the flight controller's attitude as a
+// rangefinder's range (and optionally the flight controller's attitude as a
 // prior), and vo_estimate_t goes out on POSE_VO_FEATURE. Bad messages are
 // dropped and counted.
 
@@ -34,6 +34,11 @@ struct VoFeatureNodeParams {
   // Read once: the start pose the estimate is anchored to.
   std::string truth_channel = "POSE_TRUTH";
   std::string pose_channel = "POSE_VO_FEATURE";
+  // The debug image (the thesis's figure 21): every this many frames (0: none),
+  // as JPEG of this quality.
+  std::string debug_channel = "VO_FEATURE_DEBUG";
+  int debug_every_frames = 10;
+  int debug_jpeg_quality = 80;
   // Use the flight controller's attitude as a prior for each frame's rotation.
   bool attitude_prior = false;
   // Publish the wall-clock processing time in vo_estimate_t (live); off, it is
@@ -53,10 +58,13 @@ class VoFeatureNode {
   const std::string& firstDropReason() const { return first_drop_reason_; }
   // Wall-clock seconds spent in FeatureVo::process, over all frames.
   double processingSeconds() const { return processing_s_; }
+  const FeatureVoTiming& timing() const { return vo_.timing(); }
+  const FeatureVo& vo() const { return vo_; }
 
  private:
   void onImage(const nadir::image_t& image);
   void drop(const std::string& reason);
+  void publishDebugImage(const cv::Mat& frame, std::int64_t utime, const VoFrameOutput& out);
 
   core::Bus& bus_;
   VoFeatureNodeParams params_;

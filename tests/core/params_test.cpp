@@ -624,6 +624,16 @@ TEST(ParamsGroupMap, FormatRoundTrip) {
   EXPECT_EQ(formatParamsOf(copy), formatParamsOf(rig));
 }
 
+// An empty map is formatted as {} ahead of its comment and reads back as an empty map.
+TEST(ParamsGroupMap, EmptyMapRoundTrips) {
+  RigParams rig;
+  const std::string text = formatParamsOf(rig);
+  EXPECT_EQ(text, "cameras: {}  # cameras by name\n");
+  RigParams copy;
+  ASSERT_NO_THROW(applyYamlText(text, "formatted", visitorOf(copy))) << text;
+  EXPECT_TRUE(copy.cameras.empty());
+}
+
 struct RouteParams {
   NumberRows waypoints = {{0.0, 0.0}};
   void visit(ParamVisitor& v) {

@@ -103,6 +103,24 @@ TEST(Scenario, BuiltInsLoad) {
   EXPECT_EQ(scamp.targets.at("start_corner").kind, "concentric");
 }
 
+// The effective scenario a run writes (scenario.yaml) loads back to the same
+// parameters, for every built-in scenario.
+TEST(Scenario, FormattedScenarioLoadsBack) {
+  const std::filesystem::path folder =
+      std::filesystem::path(::testing::TempDir()) / "nadir_scenario_formatted";
+  std::filesystem::create_directories(folder);
+  for (const std::string& name : builtinScenarioNames()) {
+    ScenarioParams original = loadScenario(name);
+    const std::string text = core::formatParamsOf(original);
+    const std::filesystem::path path = folder / (name + ".yaml");
+    std::ofstream(path) << text;
+    ScenarioParams copy;
+    ASSERT_NO_THROW(copy = loadScenario(path.string())) << name;
+    EXPECT_EQ(copy.targets.size(), original.targets.size()) << name;
+    EXPECT_EQ(copy.sim.vehicle.altitude_agl_m, original.sim.vehicle.altitude_agl_m) << name;
+  }
+}
+
 // The experiment axes are keys of every fixed-wing scenario and reach the models.
 TEST(Scenario, ExperimentAxesOverride) {
   for (const char* name : {"thesis-oscillating", "box", "cloverleaf", "grid", "default"}) {

@@ -5,17 +5,22 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <random>
 #include <set>
+#include <tuple>
+#include <vector>
 
 namespace nadir::vo {
 namespace {
 
 constexpr int kWidth = 1280;
 constexpr int kHeight = 960;
+// Keypoints keep this far from the image border (the descriptor patch fits).
+constexpr int kBorder = 19;
 
 // Smooth noise at three scales under random rectangles and disks: corners and
 // blobs at every pyramid level, nothing repeats.
@@ -99,6 +104,97 @@ TEST_F(FeaturesTest, SpreadOverTheGrid) {
     EXPECT_GE(per_cell[k], 10) << "cell " << k;
   }
   EXPECT_EQ(static_cast<int>(octaves.size()), params_.num_levels);
+}
+
+// With one level and one cell wanting more than there are, the keypoints are
+// all FAST corners: the same positions and scores as cv::FAST with non-maximum
+// suppression, inside the border.
+TEST_F(FeaturesTest, FindsWhatCvFastFinds) {
+  FeatureParams all = params_;
+  all.num_levels = 1;
+  all.grid_cols = 1;
+  all.grid_rows = 1;
+  all.num_features = 100000;
+  for (const int threshold : {7, 20, 45}) {
+    all.fast_threshold = threshold;
+    all.min_fast_threshold = threshold;
+    const Features f = extractOrb(image_, all);
+    std::vector<cv::KeyPoint> reference;
+    cv::FAST(image_, reference, threshold, true);
+    std::set<std::tuple<float, float, float>> expected;
+    for (const cv::KeyPoint& kp : reference) {
+      if (kp.pt.x >= kBorder && kp.pt.x < kWidth - kBorder && kp.pt.y >= kBorder &&
+          kp.pt.y < kHeight - kBorder) {
+        expected.emplace(kp.pt.x, kp.pt.y, kp.response);
+      }
+    }
+    std::set<std::tuple<float, float, float>> got;
+    for (const cv::KeyPoint& kp : f.keypoints) got.emplace(kp.pt.x, kp.pt.y, kp.response);
+    EXPECT_EQ(got, expected) << "threshold " << threshold;
+    EXPECT_GT(got.size(), 1000u);
+  }
+}
+
+// On one level, every cell keeps its share of the strongest cv::FAST corners
+// at fast_threshold, at min_fast_threshold if it has fewer; the rest goes to
+// the strongest left-overs (fast_threshold ones, or the poor cells'). The
+// left half is so faint that its cells fall back and still leave most of
+// their shares to the right half.
+TEST_F(FeaturesTest, CellsKeepTheirStrongestCorners) {
+  cv::Mat half = image_.clone();
+  cv::Mat faint = half(cv::Rect(0, 0, kWidth / 2, kHeight));
+  faint.convertTo(faint, CV_8U, 0.06, 100.0);
+  FeatureParams one = params_;
+  one.num_levels = 1;
+  for (const int wanted : {2000, 300}) {
+    one.num_features = wanted;
+    const Features f = extractOrb(half, one);
+    std::vector<cv::KeyPoint> strong;
+    std::vector<cv::KeyPoint> weak;
+    cv::FAST(half, strong, one.fast_threshold, true);
+    cv::FAST(half, weak, one.min_fast_threshold, true);
+    const int width = kWidth - 2 * kBorder;
+    const int height = kHeight - 2 * kBorder;
+    const int share = wanted / (one.grid_cols * one.grid_rows);
+    const auto stronger = [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
+      return std::tuple(-a.response, a.pt.y, a.pt.x) < std::tuple(-b.response, b.pt.y, b.pt.x);
+    };
+    std::vector<cv::KeyPoint> kept;
+    std::vector<cv::KeyPoint> spare;
+    for (int r = 0; r < one.grid_rows; ++r) {
+      for (int c = 0; c < one.grid_cols; ++c) {
+        const cv::Rect cell(kBorder + c * width / one.grid_cols,
+                            kBorder + r * height / one.grid_rows, 0, 0);
+        const cv::Point end(kBorder + (c + 1) * width / one.grid_cols,
+                            kBorder + (r + 1) * height / one.grid_rows);
+        const auto in_cell = [&](const std::vector<cv::KeyPoint>& corners) {
+          std::vector<cv::KeyPoint> out;
+          for (const cv::KeyPoint& kp : corners) {
+            if (kp.pt.x >= cell.x && kp.pt.x < end.x && kp.pt.y >= cell.y && kp.pt.y < end.y) {
+              out.push_back(kp);
+            }
+          }
+          return out;
+        };
+        std::vector<cv::KeyPoint> corners = in_cell(strong);
+        if (static_cast<int>(corners.size()) < std::max(share, 1)) corners = in_cell(weak);
+        std::sort(corners.begin(), corners.end(), stronger);
+        const std::size_t take = std::min(corners.size(), static_cast<std::size_t>(share));
+        kept.insert(kept.end(), corners.begin(), corners.begin() + static_cast<long>(take));
+        spare.insert(spare.end(), corners.begin() + static_cast<long>(take), corners.end());
+      }
+    }
+    std::sort(spare.begin(), spare.end(), stronger);
+    const std::size_t missing = static_cast<std::size_t>(wanted) - kept.size();
+    kept.insert(kept.end(), spare.begin(),
+                spare.begin() + static_cast<long>(std::min(missing, spare.size())));
+    std::sort(kept.begin(), kept.end(), stronger);
+    ASSERT_EQ(f.keypoints.size(), kept.size()) << wanted << " wanted";
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      EXPECT_EQ(f.keypoints[i].pt, kept[i].pt) << i;
+      EXPECT_EQ(f.keypoints[i].response, kept[i].response) << i;
+    }
+  }
 }
 
 // A uniform image has no corners, at either threshold.
@@ -190,6 +286,34 @@ TEST_F(FeaturesTest, BruteForceMatchingRecoversAShift) {
   const std::vector<cv::DMatch> matches = matchBruteForce(a, b, 50, 0.8f);
   EXPECT_GT(matches.size(), a.keypoints.size() / 3);
   EXPECT_GT(shareWithShift(a, b, matches, 7.0, -4.0, params_.scale_factor), 0.9);
+}
+
+// The descriptors turn with the keypoint angle: a copy rotated by 30 degrees
+// about the centre matches without any prediction, and the matches land where
+// the rotation puts them.
+TEST_F(FeaturesTest, MatchesAcrossAnInPlaneRotation) {
+  const cv::Point2f centre(kWidth / 2.0f, kHeight / 2.0f);
+  const cv::Mat rotation = cv::getRotationMatrix2D(centre, 30.0, 1.0);
+  cv::Mat rotated;
+  cv::warpAffine(image_, rotated, rotation, image_.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                 cv::Scalar(0));
+  const Features a = extractOrb(image_, params_);
+  const Features b = extractOrb(rotated, params_);
+  const std::vector<cv::DMatch> matches = matchBruteForce(a, b, 64, 0.9f);
+  int right = 0;
+  for (const cv::DMatch& m : matches) {
+    const cv::KeyPoint& ka = a.keypoints[static_cast<std::size_t>(m.queryIdx)];
+    const cv::KeyPoint& kb = b.keypoints[static_cast<std::size_t>(m.trainIdx)];
+    const cv::Point2d expected(rotation.at<double>(0, 0) * ka.pt.x +
+                                   rotation.at<double>(0, 1) * ka.pt.y + rotation.at<double>(0, 2),
+                               rotation.at<double>(1, 0) * ka.pt.x +
+                                   rotation.at<double>(1, 1) * ka.pt.y + rotation.at<double>(1, 2));
+    const double tolerance = 2.0 * std::pow(params_.scale_factor, std::max(ka.octave, kb.octave));
+    if (cv::norm(expected - cv::Point2d(kb.pt)) <= tolerance) ++right;
+  }
+  // A fifth of the image or so turns out of view.
+  EXPECT_GT(right, static_cast<int>(a.keypoints.size()) * 2 / 5);
+  EXPECT_GT(static_cast<double>(right), 0.95 * static_cast<double>(matches.size()));
 }
 
 // The orientation histogram keeps the true matches and drops random pairings.
