@@ -1,0 +1,104 @@
+// nadir-plot: the plot viewer. --headless renders a run's charts to PNG files
+// and its error table to results.csv; the interactive viewer is not built yet.
+//
+//   nadir-plot --headless RUN_DIR --out DIR
+//
+// RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
+// DIR/<its path under RUN_DIR>.
+
+#include <CLI/CLI.hpp>
+
+#include <QApplication>
+
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "gui/plots.h"
+#include "gui/run_data.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 1200;
+constexpr int kHeight = 800;
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::trunc);
+  out << text;
+  out.flush();
+  if (!out) throw nadir::gui::RunDataError(path.string() + ": cannot write the file");
+}
+
+void renderRun(const std::string& run_dir, const fs::path& out_dir) {
+  const nadir::gui::RunData run = nadir::gui::loadRun(run_dir);
+  if (!run.damage.empty()) {
+    std::fprintf(stderr, "nadir-plot: %s: damaged, plotting what could be read: %s\n",
+                 run.poses_from.c_str(), run.damage.c_str());
+  }
+  std::error_code error;
+  fs::create_directories(out_dir, error);
+  if (error) {
+    throw nadir::gui::RunDataError(out_dir.string() +
+                                   ": cannot create the directory: " + error.message());
+  }
+  for (nadir::gui::Figure& figure : nadir::gui::buildFigures(run)) {
+    const fs::path path = out_dir / (figure.name + ".png");
+    nadir::gui::renderFigurePng(std::move(figure), path.string(), kWidth, kHeight);
+    std::printf("%s\n", path.c_str());
+  }
+  const fs::path csv = out_dir / "results.csv";
+  writeText(csv, nadir::gui::resultsCsv(run.metrics));
+  std::printf("%s\n", csv.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"nadir-plot: plots of a run (truth and estimates) and its error table"};
+  std::string run_dir;
+  std::string out_dir;
+  bool headless = false;
+  app.add_option("run_dir", run_dir,
+                 "a run directory (as `nadir run` writes it), or a tree of runs")
+      ->required();
+  app.add_flag("--headless", headless, "render PNG files and results.csv instead of a window");
+  app.add_option("--out", out_dir, "where --headless writes its files");
+  CLI11_PARSE(app, argc, argv);
+
+  if (!headless) {
+    std::fprintf(stderr,
+                 "nadir-plot: the interactive viewer is not built yet; use --headless RUN_DIR "
+                 "--out DIR\n");
+    return 2;
+  }
+  if (out_dir.empty()) {
+    std::fprintf(stderr, "nadir-plot: --headless needs --out DIR\n");
+    return 1;
+  }
+
+  // Headless needs no display: Qt's offscreen platform, unless one was chosen.
+  if (std::getenv("QT_QPA_PLATFORM") == nullptr) setenv("QT_QPA_PLATFORM", "offscreen", 1);
+
+  try {
+    const std::vector<std::string> runs = nadir::gui::findRuns(run_dir);
+    if (runs.empty()) {
+      throw nadir::gui::RunDataError(
+          run_dir + ": no run here (a run is a folder with run.lcmlog, truth.tum or metrics.json)");
+    }
+    QApplication application(argc, argv);
+    for (const std::string& run : runs) {
+      const fs::path relative = fs::path(run).lexically_relative(run_dir);
+      renderRun(run, relative == "." ? fs::path(out_dir) : fs::path(out_dir) / relative);
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "nadir-plot: %s\n", error.what());
+    return 1;
+  }
+  return 0;
+}

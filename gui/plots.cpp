@@ -1,0 +1,343 @@
+#include "gui/plots.h"
+
+#include <QApplication>
+#include <QChartView>
+#include <QColor>
+#include <QImage>
+#include <QLegend>
+#include <QLegendMarker>
+#include <QLineSeries>
+#include <QPainter>
+#include <QPen>
+#include <QVBoxLayout>
+#include <QValueAxis>
+#include <QWidget>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <utility>
+
+namespace nadir::gui {
+namespace {
+
+// Enough points for a 1200 px wide chart; more only slow the drawing down.
+constexpr std::size_t kMaxPointsPerSeries = 4000;
+// A line is broken where samples are further apart than this (a gap in the
+// estimates), so that no pose is drawn where there was none.
+constexpr double kMaxGap_s = 1.0;
+
+const QColor kTruthColor(Qt::black);
+
+QColor sourceColor(const RunData& run, const std::string& name) {
+  // Known sources keep their colour across runs; others take the rest in order.
+  if (name == "ppa") return QColor(0x1f, 0x77, 0xb4);
+  if (name == "vo_feature") return QColor(0xff, 0x7f, 0x0e);
+  if (name == "vo_direct") return QColor(0x2c, 0xa0, 0x2c);
+  static const QColor kOthers[] = {QColor(0x94, 0x67, 0xbd), QColor(0x8c, 0x56, 0x4b),
+                                   QColor(0xe3, 0x77, 0xc2), QColor(0x17, 0xbe, 0xcf),
+                                   QColor(0xbc, 0xbd, 0x22), QColor(0x7f, 0x7f, 0x7f)};
+  std::size_t index = 0;
+  for (const auto& [other, series] : run.sources) {
+    if (other == name) break;
+    if (other != "ppa" && other != "vo_feature" && other != "vo_direct") ++index;
+  }
+  return kOthers[index % std::size(kOthers)];
+}
+
+struct Range {
+  double min = std::numeric_limits<double>::infinity();
+  double max = -std::numeric_limits<double>::infinity();
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    min = std::min(min, v);
+    max = std::max(max, v);
+  }
+  bool empty() const { return min > max; }
+};
+
+// One chart with value axes; every line added goes on both axes.
+class ChartBuilder {
+ public:
+  ChartBuilder(const QString& title, const QString& x_title, const QString& y_title)
+      : chart_(std::make_unique<QChart>()) {
+    chart_->setTitle(title);
+    chart_->legend()->setVisible(true);
+    chart_->legend()->setAlignment(Qt::AlignRight);
+    chart_->setMargins(QMargins(4, 4, 4, 4));
+    x_axis_ = new QValueAxis;
+    y_axis_ = new QValueAxis;
+    x_axis_->setTitleText(x_title);
+    y_axis_->setTitleText(y_title);
+    chart_->addAxis(x_axis_, Qt::AlignBottom);
+    chart_->addAxis(y_axis_, Qt::AlignLeft);
+  }
+
+  // Draws (x[i], y[i]) as one legend entry; the line breaks at NaN, at time gaps
+  // (t may be empty: no gap test), and, for angles, where they wrap at +-180 deg.
+  void addLine(const QString& name, const QColor& color, double width, const std::vector<double>& t,
+               const std::vector<double>& x, const std::vector<double>& y, bool wraps = false) {
+    const std::size_t n = std::min(x.size(), y.size());
+    const std::size_t stride =
+        std::max<std::size_t>(1, (n + kMaxPointsPerSeries - 1) / kMaxPointsPerSeries);
+    QPen pen(color);
+    pen.setWidthF(width);
+    QLineSeries* segment = nullptr;
+    bool named = false;
+    std::size_t last = 0;
+    const auto finish = [&] {
+      if (segment == nullptr) return;
+      attach(segment, named);
+      named = true;
+      segment = nullptr;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(x[i]) || !std::isfinite(y[i])) {
+        finish();
+        continue;
+      }
+      if (segment != nullptr) {
+        const bool gap = !t.empty() && t[i] - t[last] > kMaxGap_s;
+        const bool wrap = wraps && std::abs(y[i] - y[last]) > 180.0;
+        if (gap || wrap) {
+          finish();
+        } else if (i - last < stride && i + 1 < n) {
+          continue;
+        }
+      }
+      if (segment == nullptr) {
+        segment = new QLineSeries;
+        segment->setName(name);
+        segment->setPen(pen);
+      }
+      segment->append(x[i], y[i]);
+      x_range_.add(x[i]);
+      y_range_.add(y[i]);
+      last = i;
+    }
+    finish();
+    if (!named) {
+      // Nothing to draw: still list the source, so that its absence shows.
+      auto* empty = new QLineSeries;
+      empty->setName(name + " (no pose)");
+      empty->setPen(pen);
+      attach(empty, false);
+    }
+  }
+
+  Range xRange() const { return x_range_; }
+  Range yRange() const { return y_range_; }
+
+  // Fits the axes to the data drawn, with round tick values.
+  std::unique_ptr<QChart> take() {
+    setRange(x_axis_, x_range_, 0.0);
+    setRange(y_axis_, y_range_, 0.05);
+    return std::move(chart_);
+  }
+
+  // The axes left to the caller.
+  std::unique_ptr<QChart> takeAsIs() { return std::move(chart_); }
+
+  QValueAxis* xAxis() const { return x_axis_; }
+  QValueAxis* yAxis() const { return y_axis_; }
+
+ private:
+  void attach(QLineSeries* series, bool hide_from_legend) {
+    chart_->addSeries(series);
+    series->attachAxis(x_axis_);
+    series->attachAxis(y_axis_);
+    if (hide_from_legend) {
+      for (QLegendMarker* marker : chart_->legend()->markers(series)) marker->setVisible(false);
+    }
+  }
+
+  static void setRange(QValueAxis* axis, const Range& range, double margin) {
+    if (range.empty()) {
+      axis->setRange(0, 1);
+      return;
+    }
+    double lo = range.min;
+    double hi = range.max;
+    const double pad = std::max((hi - lo) * margin, hi == lo ? 1.0 : 0.0);
+    lo -= pad;
+    hi += pad;
+    axis->setRange(lo, hi);
+    axis->applyNiceNumbers();
+  }
+
+  std::unique_ptr<QChart> chart_;
+  QValueAxis* x_axis_ = nullptr;
+  QValueAxis* y_axis_ = nullptr;
+  Range x_range_;
+  Range y_range_;
+};
+
+std::vector<double> sinceStart(const std::vector<double>& t_s, double t0_s) {
+  std::vector<double> out(t_s.size());
+  std::transform(t_s.begin(), t_s.end(), out.begin(), [t0_s](double t) { return t - t0_s; });
+  return out;
+}
+
+QString runName(const RunData& run) {
+  std::filesystem::path path = std::filesystem::path(run.dir).lexically_normal();
+  if (!path.has_filename()) path = path.parent_path();  // "dir/" names dir
+  return QString::fromStdString(path.filename().string());
+}
+
+using Field = std::vector<double> PoseSeries::*;
+
+// One chart per field of the pose, truth and every source on each.
+Figure timeFigure(const RunData& run, const std::string& name, const QString& title,
+                  const std::vector<std::pair<Field, QString>>& fields, bool angles) {
+  Figure figure;
+  figure.name = name;
+  const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    const auto& [field, label] = fields[k];
+    ChartBuilder chart(k == 0 ? title + ": " + runName(run) : QString(), "time (s)", label);
+    chart.addLine("truth", kTruthColor, 2.0, truth_t, truth_t, run.truth.*field, angles);
+    for (const auto& [source, series] : run.sources) {
+      const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
+      chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
+                    series.pose.*field, angles);
+    }
+    figure.charts.push_back(chart.take());
+  }
+  return figure;
+}
+
+// Widens the shorter span so that both axes have the same metres per pixel.
+void equalizeAxes(QValueAxis* x_axis, QValueAxis* y_axis, const Range& x, const Range& y,
+                  const QRectF& area) {
+  if (area.width() <= 0 || area.height() <= 0 || x.empty() || y.empty()) return;
+  const double pad = 0.05 * std::max({x.max - x.min, y.max - y.min, 1.0});
+  double x_span = x.max - x.min + 2 * pad;
+  double y_span = y.max - y.min + 2 * pad;
+  const double scale = std::max(x_span / area.width(), y_span / area.height());
+  x_span = scale * area.width();
+  y_span = scale * area.height();
+  const double x_mid = 0.5 * (x.min + x.max);
+  const double y_mid = 0.5 * (y.min + y.max);
+  x_axis->setRange(x_mid - 0.5 * x_span, x_mid + 0.5 * x_span);
+  y_axis->setRange(y_mid - 0.5 * y_span, y_mid + 0.5 * y_span);
+  // Ranges fitted to pixels are not round: ticks at round multiples of one
+  // step (1, 2 or 5 times a power of ten, about 100 px apart), the same on both axes.
+  const double rough = 100.0 * scale;
+  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+  const double step = decade * (rough < 2 * decade ? 1 : rough < 5 * decade ? 2 : 5);
+  for (QValueAxis* axis : {x_axis, y_axis}) {
+    axis->setTickType(QValueAxis::TicksDynamic);
+    axis->setTickAnchor(0.0);
+    axis->setTickInterval(step);
+    axis->setLabelFormat(step >= 1 ? "%.0f" : "%.2g");
+  }
+}
+
+}  // namespace
+
+Figure positionFigure(const RunData& run) {
+  return timeFigure(run, "position", "Position (world NED)",
+                    {{&PoseSeries::x_m, "north x (m)"},
+                     {&PoseSeries::y_m, "east y (m)"},
+                     {&PoseSeries::z_m, "down z (m)"}},
+                    false);
+}
+
+Figure attitudeFigure(const RunData& run) {
+  return timeFigure(run, "attitude", "Attitude (Z-Y-X)",
+                    {{&PoseSeries::roll_deg, "roll (deg)"},
+                     {&PoseSeries::pitch_deg, "pitch (deg)"},
+                     {&PoseSeries::yaw_deg, "yaw (deg)"}},
+                    true);
+}
+
+Figure errorFigure(const RunData& run) {
+  Figure figure;
+  figure.name = "error";
+  ChartBuilder chart("Position error: " + runName(run), "time (s)", "|p_est - p_truth| (m)");
+  for (const auto& [source, series] : run.sources) {
+    const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
+    chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
+                  series.position_error_m);
+  }
+  std::unique_ptr<QChart> built = chart.take();
+  // An error axis starts at zero: the error's size, not its wiggle, is the point.
+  auto* y_axis = static_cast<QValueAxis*>(built->axes(Qt::Vertical).front());
+  if (!chart.yRange().empty()) {
+    y_axis->setRange(0, chart.yRange().max * 1.05);
+    y_axis->applyNiceNumbers();
+  }
+  figure.charts.push_back(std::move(built));
+  return figure;
+}
+
+Figure topViewFigure(const RunData& run) {
+  Figure figure;
+  figure.name = "top_view";
+  ChartBuilder chart("Top view: " + runName(run), "east y (m)", "north x (m)");
+  const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
+  chart.addLine("truth", kTruthColor, 2.0, truth_t, run.truth.y_m, run.truth.x_m);
+  for (const auto& [source, series] : run.sources) {
+    const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
+    chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, series.pose.y_m,
+                  series.pose.x_m);
+  }
+  const Range x = chart.xRange();
+  const Range y = chart.yRange();
+  QValueAxis* x_axis = chart.xAxis();
+  QValueAxis* y_axis = chart.yAxis();
+  std::unique_ptr<QChart> built = chart.takeAsIs();
+  QChart* raw = built.get();
+  equalizeAxes(x_axis, y_axis, x, y, raw->plotArea());
+  // The plot area is known only once the chart is laid out, and changes with it.
+  // Queued: a range set while the chart is laying itself out re-enters the layout.
+  QObject::connect(
+      raw, &QChart::plotAreaChanged, raw,
+      [=](const QRectF& area) { equalizeAxes(x_axis, y_axis, x, y, area); }, Qt::QueuedConnection);
+  figure.charts.push_back(std::move(built));
+  return figure;
+}
+
+std::vector<Figure> buildFigures(const RunData& run) {
+  std::vector<Figure> figures;
+  figures.push_back(positionFigure(run));
+  figures.push_back(attitudeFigure(run));
+  figures.push_back(errorFigure(run));
+  figures.push_back(topViewFigure(run));
+  return figures;
+}
+
+std::unique_ptr<QWidget> figureWidget(Figure figure) {
+  auto widget = std::make_unique<QWidget>();
+  widget->setWindowTitle(QString::fromStdString(figure.name));
+  auto* layout = new QVBoxLayout(widget.get());
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->setSpacing(0);
+  for (std::unique_ptr<QChart>& chart : figure.charts) {
+    auto* view = new QChartView(chart.release());
+    view->setRenderHint(QPainter::Antialiasing);
+    layout->addWidget(view);
+  }
+  return widget;
+}
+
+void renderFigurePng(Figure figure, const std::string& path, int width, int height) {
+  std::unique_ptr<QWidget> widget = figureWidget(std::move(figure));
+  widget->resize(width, height);
+  // Drawing once delivers the resize; the charts then lay themselves out (and the
+  // top view reacts to its plot area) in the events that follow. No window is shown.
+  QImage image(width, height, QImage::Format_RGB32);
+  widget->render(&image);
+  for (int i = 0; i < 3; ++i) QApplication::processEvents();
+  image.fill(Qt::white);
+  QPainter painter(&image);
+  widget->render(&painter);
+  painter.end();
+  if (!image.save(QString::fromStdString(path), "PNG")) {
+    throw RunDataError(path + ": cannot write the PNG file");
+  }
+}
+
+}  // namespace nadir::gui

@@ -1,0 +1,43 @@
+#pragma once
+// The plot viewer's charts of a run (Qt Charts), shared by the headless renderer
+// and the interactive viewer. Truth is always black, each source keeps its own
+// colour in every chart (ppa, vo_feature and vo_direct the same in every run).
+// Time axes show seconds since the truth's first pose.
+
+#include <QChart>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gui/run_data.h"
+
+class QWidget;
+
+namespace nadir::gui {
+
+// Charts shown together, stacked top to bottom.
+struct Figure {
+  std::string name;  // a file stem: position, attitude, error, top_view
+  std::vector<std::unique_ptr<QChart>> charts;
+};
+
+// north x, east y, down z against time (truth and each source).
+Figure positionFigure(const RunData& run);
+// roll, pitch, yaw against time (truth and each source).
+Figure attitudeFigure(const RunData& run);
+// Each source's position error norm against time.
+Figure errorFigure(const RunData& run);
+// East against north, the same metres per pixel on both axes whatever the size.
+Figure topViewFigure(const RunData& run);
+// The four above, in that order.
+std::vector<Figure> buildFigures(const RunData& run);
+
+// A widget showing the figure's charts, which it takes over.
+std::unique_ptr<QWidget> figureWidget(Figure figure);
+
+// Renders the figure to a width x height PNG. Needs a QApplication. Throws
+// RunDataError naming the path if it cannot write it.
+void renderFigurePng(Figure figure, const std::string& path, int width, int height);
+
+}  // namespace nadir::gui

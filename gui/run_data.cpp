@@ -1,0 +1,188 @@
+#include "gui/run_data.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <system_error>
+#include <utility>
+
+#include "core/frames.h"
+#include "eval/trajectory.h"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr char kLogName[] = "run.lcmlog";
+constexpr char kTruthName[] = "truth.tum";
+constexpr char kMetricsName[] = "metrics.json";
+
+bool isFile(const fs::path& path) {
+  std::error_code error;
+  return fs::is_regular_file(path, error);
+}
+
+void appendPose(PoseSeries& series, double t_s, const Eigen::Vector3d& p_m,
+                const Eigen::Quaterniond& q) {
+  const core::RollPitchYaw rpy = core::rpyFromQuaternion(q);
+  series.t_s.push_back(t_s);
+  series.x_m.push_back(p_m.x());
+  series.y_m.push_back(p_m.y());
+  series.z_m.push_back(p_m.z());
+  series.roll_deg.push_back(rpy.roll_rad * kDegPerRad);
+  series.pitch_deg.push_back(rpy.pitch_rad * kDegPerRad);
+  series.yaw_deg.push_back(rpy.yaw_rad * kDegPerRad);
+}
+
+void appendEmpty(PoseSeries& series, double t_s) {
+  series.t_s.push_back(t_s);
+  for (std::vector<double>* v : {&series.x_m, &series.y_m, &series.z_m, &series.roll_deg,
+                                 &series.pitch_deg, &series.yaw_deg}) {
+    v->push_back(kNaN);
+  }
+}
+
+SourceSeries sourceSeries(const eval::PoseTrajectory& truth,
+                          const std::vector<eval::SourceEstimate>& estimates,
+                          double truth_max_gap_s) {
+  SourceSeries series;
+  for (const eval::SourceEstimate& e : estimates) {
+    series.status.push_back(e.status);
+    if (e.status != eval::SourceEstimate::kTracking) {
+      appendEmpty(series.pose, e.t_s);
+      series.position_error_m.push_back(kNaN);
+      continue;
+    }
+    appendPose(series.pose, e.t_s, e.p_m, e.q);
+    const std::optional<eval::StampedPose> reference =
+        eval::interpolate(truth, e.t_s, truth_max_gap_s);
+    series.position_error_m.push_back(reference ? (e.p_m - reference->p_m).norm() : kNaN);
+  }
+  return series;
+}
+
+std::vector<eval::SourceEstimate> trackingEstimates(const eval::PoseTrajectory& trajectory) {
+  std::vector<eval::SourceEstimate> estimates;
+  estimates.reserve(trajectory.size());
+  for (const eval::StampedPose& pose : trajectory) {
+    estimates.push_back({pose.t_s, eval::SourceEstimate::kTracking, pose.p_m, pose.q});
+  }
+  return estimates;
+}
+
+eval::PoseTrajectory readTumFile(const fs::path& path) {
+  eval::PoseTrajectory trajectory = eval::readTum(path.string());
+  if (trajectory.empty()) throw RunDataError(path.string() + ": no pose in the file");
+  return trajectory;
+}
+
+void appendNumber(std::string& out, double value) {
+  if (!std::isfinite(value)) return;
+  char text[32];
+  const std::to_chars_result result = std::to_chars(text, text + sizeof text, value);
+  out.append(text, result.ptr);
+}
+
+}  // namespace
+
+bool isRunDir(const std::string& dir) {
+  const fs::path path(dir);
+  return isFile(path / kLogName) || isFile(path / kTruthName) || isFile(path / kMetricsName);
+}
+
+std::vector<std::string> findRuns(const std::string& root) {
+  std::error_code error;
+  if (!fs::is_directory(root, error)) throw RunDataError(root + ": not a directory");
+  if (isRunDir(root)) return {root};
+  std::vector<std::string> runs;
+  fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
+  if (error) throw RunDataError(root + ": cannot list the directory: " + error.message());
+  for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
+    if (error) throw RunDataError(root + ": cannot list the directory: " + error.message());
+    if (!it->is_directory(error) || !isRunDir(it->path().string())) continue;
+    runs.push_back(it->path().string());
+    it.disable_recursion_pending();  // a run's subfolders are not runs of their own
+  }
+  std::sort(runs.begin(), runs.end());
+  return runs;
+}
+
+RunData loadRun(const std::string& dir) {
+  const fs::path root(dir);
+  std::error_code error;
+  if (!fs::is_directory(root, error)) throw RunDataError(dir + ": not a directory");
+  RunData run;
+  run.dir = dir;
+  try {
+    const fs::path metrics_path = root / kMetricsName;
+    if (isFile(metrics_path)) {
+      run.metrics = eval::readMetricsJson(metrics_path.string(), &run.options);
+      run.metrics_from = metrics_path.string();
+    }
+
+    eval::PoseTrajectory truth;
+    std::map<std::string, std::vector<eval::SourceEstimate>> estimates;
+    const fs::path log_path = root / kLogName;
+    const fs::path truth_path = root / kTruthName;
+    if (isFile(log_path)) {
+      eval::LogTrajectories recorded = eval::readRunLog(log_path.string());
+      truth = std::move(recorded.truth);
+      estimates = std::move(recorded.sources);
+      run.damage = std::move(recorded.damage);
+      run.poses_from = log_path.string();
+    } else if (isFile(truth_path)) {
+      truth = readTumFile(truth_path);
+      for (const fs::directory_entry& entry : fs::directory_iterator(root)) {
+        const fs::path& path = entry.path();
+        if (path.extension() != ".tum" || path.filename() == kTruthName) continue;
+        if (!entry.is_regular_file()) continue;
+        estimates[path.stem().string()] = trackingEstimates(readTumFile(path));
+      }
+      run.poses_from = truth_path.string();
+    } else {
+      throw RunDataError(dir + ": neither " + kLogName + " nor " + kTruthName +
+                         ": no poses to plot");
+    }
+
+    if (run.metrics_from.empty()) {
+      try {
+        run.metrics = eval::evaluate(truth, estimates, run.options);
+      } catch (const eval::EvalError& e) {
+        throw RunDataError(run.poses_from + ": cannot evaluate: " + e.what());
+      }
+    }
+    run.t0_s = truth.front().t_s;
+    for (const eval::StampedPose& pose : truth) appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
+    for (const auto& [name, source] : estimates) {
+      run.sources[name] = sourceSeries(truth, source, run.options.truth_max_gap_s);
+    }
+  } catch (const eval::EvalError& e) {
+    throw RunDataError(e.what());
+  } catch (const fs::filesystem_error& e) {
+    throw RunDataError(dir + ": " + e.what());
+  }
+  return run;
+}
+
+std::string resultsCsv(const eval::RunMetrics& metrics) {
+  std::string out = "source,position_rmse_m,rotation_rmse_deg,tracked_pct,ape_rmse_m,rpe_rmse_m\n";
+  for (const auto& [name, m] : metrics.sources) {
+    out += name;
+    for (const double value : {m.position_rmse_m, m.rotation_rmse_deg, m.tracked_pct,
+                               m.ape_translation_m.rmse, m.rpe_translation_m.rmse}) {
+      out += ',';
+      appendNumber(out, value);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace nadir::gui

@@ -1,0 +1,77 @@
+#pragma once
+// A tiny run directory for the plot viewer's tests, with errors known by
+// construction: the truth flies a straight line at (10, 5, 0) m/s for 10 s from
+// t = 100 s, sampled at 10 Hz, at a constant attitude (roll 5, pitch -10,
+// yaw 30 deg); the source "vo_test" estimates at 2 Hz from t = 100.5 s to
+// 109.5 s (19 estimates) with the truth's attitude and its position moved by
+// (3, 4, 0) m, so every position error is exactly 5 m.
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/frames.h"
+#include "eval/run_metrics.h"
+#include "eval/trajectory.h"
+
+namespace nadir::gui::test {
+
+inline constexpr double kT0 = 100.0;
+inline constexpr int kTruthPoses = 101;
+inline constexpr int kEstimates = 19;
+inline constexpr double kRollDeg = 5.0;
+inline constexpr double kPitchDeg = -10.0;
+inline constexpr double kYawDeg = 30.0;
+inline const Eigen::Vector3d kOffset(3.0, 4.0, 0.0);
+
+inline Eigen::Quaterniond attitude() {
+  constexpr double kRad = std::numbers::pi / 180.0;
+  return core::quaternionFromRpy({kRollDeg * kRad, kPitchDeg * kRad, kYawDeg * kRad});
+}
+
+inline Eigen::Vector3d truthPosition(double t_s) {
+  const double dt = t_s - kT0;
+  return Eigen::Vector3d(10.0 * dt, 5.0 * dt, -100.0);
+}
+
+inline double truthStamp(int k) { return kT0 + 0.1 * k; }
+inline double estimateStamp(int j) { return kT0 + 0.5 + 0.5 * j; }
+
+inline eval::PoseTrajectory truthTrajectory() {
+  eval::PoseTrajectory truth;
+  for (int k = 0; k < kTruthPoses; ++k) {
+    truth.push_back({truthStamp(k), truthPosition(truthStamp(k)), attitude()});
+  }
+  return truth;
+}
+
+inline eval::PoseTrajectory estimateTrajectory() {
+  eval::PoseTrajectory estimates;
+  for (int j = 0; j < kEstimates; ++j) {
+    const double t = estimateStamp(j);
+    estimates.push_back({t, truthPosition(t) + kOffset, attitude()});
+  }
+  return estimates;
+}
+
+// A fresh, empty directory under the test's temporary directory.
+inline std::filesystem::path freshDir(const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / ("nadir_gui_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// truth.tum and vo_test.tum, no log, no metrics.json.
+inline std::filesystem::path writeTumRun(const std::string& name) {
+  const std::filesystem::path dir = freshDir(name);
+  eval::writeTum((dir / "truth.tum").string(), truthTrajectory());
+  eval::writeTum((dir / "vo_test.tum").string(), estimateTrajectory());
+  return dir;
+}
+
+}  // namespace nadir::gui::test

@@ -1,0 +1,66 @@
+// nadir-plot as a program: its exit codes and the files --headless writes.
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "gui_test_util.h"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+int runPlot(const std::string& arguments) {
+  const std::string command = std::string(NADIR_PLOT_BIN) + " " + arguments + " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(GuiPlotCli, HeadlessWritesThePngsAndTheResultsTable) {
+  const fs::path run = test::writeTumRun("cli_run");
+  const fs::path out = test::freshDir("cli_out") / "plots";
+  ASSERT_EQ(runPlot("--headless " + run.string() + " --out " + out.string()), 0);
+  for (const char* name : {"position.png", "attitude.png", "error.png", "top_view.png"}) {
+    EXPECT_GT(fs::file_size(out / name), 1000u) << name;
+  }
+  std::ifstream csv(out / "results.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  // Position RMSE 5 m (every error is |(3, 4, 0)|), no rotation error, 95 % tracked.
+  EXPECT_EQ(text.rfind("source,position_rmse_m,rotation_rmse_deg,tracked_pct,", 0), 0u) << text;
+  EXPECT_NE(text.find("\nvo_test,5,"), std::string::npos) << text;
+}
+
+TEST(GuiPlotCli, HeadlessRendersEveryRunOfATree) {
+  const fs::path root = test::freshDir("cli_tree");
+  fs::create_directories(root / "cell_a");
+  fs::create_directories(root / "cell_b");
+  for (const char* cell : {"cell_a", "cell_b"}) {
+    fs::copy(test::writeTumRun(std::string("cli_tree_") + cell), root / cell);
+  }
+  const fs::path out = test::freshDir("cli_tree_out");
+  ASSERT_EQ(runPlot("--headless " + root.string() + " --out " + out.string()), 0);
+  EXPECT_TRUE(fs::exists(out / "cell_a" / "top_view.png"));
+  EXPECT_TRUE(fs::exists(out / "cell_b" / "results.csv"));
+}
+
+TEST(GuiPlotCli, BadInputFails) {
+  const fs::path empty = test::freshDir("cli_empty");
+  const fs::path out = test::freshDir("cli_bad_out");
+  EXPECT_EQ(runPlot("--headless " + (empty / "missing").string() + " --out " + out.string()), 1);
+  EXPECT_EQ(runPlot("--headless " + empty.string() + " --out " + out.string()), 1);  // no run
+  EXPECT_EQ(runPlot("--headless " + empty.string()), 1);                             // no --out
+  const fs::path damaged = test::writeTumRun("cli_damaged");
+  std::ofstream(damaged / "truth.tum", std::ios::app) << "oops\n";
+  EXPECT_EQ(runPlot("--headless " + damaged.string() + " --out " + out.string()), 1);
+  // The interactive viewer does not exist yet.
+  EXPECT_EQ(runPlot(test::writeTumRun("cli_interactive").string()), 2);
+}
+
+}  // namespace
+}  // namespace nadir::gui

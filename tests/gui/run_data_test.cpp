@@ -1,0 +1,223 @@
+#include "gui/run_data.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/bus.h"
+#include "core/lcm_log.h"
+#include "gui_test_util.h"
+#include "nadir/pose_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+using eval::SourceEstimate;
+using test::kEstimates;
+using test::kTruthPoses;
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::trunc) << text;
+}
+
+nadir::pose_t poseMessage(double t_s, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  nadir::pose_t msg{};
+  msg.utime = static_cast<std::int64_t>(std::llround(t_s * 1e6));
+  for (int i = 0; i < 3; ++i) msg.pos[i] = p[i];
+  core::quaternionToWire(q, msg.orientation);
+  return msg;
+}
+
+template <class Msg>
+void writeMessage(core::LcmLogWriter& writer, const std::string& channel, const Msg& msg) {
+  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
+  writer.write(msg.utime, channel, bytes.data(), bytes.size());
+}
+
+// The tiny run as `nadir run` records it, with the fifth estimate LOST.
+constexpr int kLostEstimate = 4;
+fs::path writeLogRun(const std::string& name) {
+  const fs::path dir = test::freshDir(name);
+  core::LcmLogWriter writer((dir / "run.lcmlog").string());
+  for (const eval::StampedPose& pose : test::truthTrajectory()) {
+    writeMessage(writer, "POSE_TRUTH", poseMessage(pose.t_s, pose.p_m, pose.q));
+  }
+  const eval::PoseTrajectory estimates = test::estimateTrajectory();
+  for (int j = 0; j < kEstimates; ++j) {
+    const eval::StampedPose& pose = estimates[static_cast<std::size_t>(j)];
+    nadir::vo_estimate_t msg{};
+    msg.utime = poseMessage(pose.t_s, pose.p_m, pose.q).utime;
+    msg.source = "vo_feature";
+    msg.status = j == kLostEstimate ? SourceEstimate::kLost : SourceEstimate::kTracking;
+    msg.pose = poseMessage(pose.t_s, pose.p_m, pose.q);
+    writeMessage(writer, "POSE_VO_FEATURE", msg);
+  }
+  return dir;
+}
+
+TEST(GuiRunData, FindsRunsInATree) {
+  const fs::path root = test::freshDir("tree");
+  fs::create_directories(root / "a" / "run1" / "sub");
+  fs::create_directories(root / "b" / "c" / "run2");
+  fs::create_directories(root / "empty");
+  writeText(root / "a" / "run1" / "truth.tum", "");
+  writeText(root / "a" / "run1" / "sub" / "truth.tum", "");  // inside a run: not a run
+  writeText(root / "b" / "c" / "run2" / "metrics.json", "{}");
+  writeText(root / "empty" / "notes.txt", "");
+
+  const std::vector<std::string> runs = findRuns(root.string());
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(fs::path(runs[0]), root / "a" / "run1");
+  EXPECT_EQ(fs::path(runs[1]), root / "b" / "c" / "run2");
+  EXPECT_TRUE(isRunDir((root / "b" / "c" / "run2").string()));
+  EXPECT_FALSE(isRunDir((root / "empty").string()));
+  // A run given directly is the only run.
+  EXPECT_EQ(findRuns((root / "a" / "run1").string()).size(), 1u);
+  EXPECT_THROW(findRuns((root / "missing").string()), RunDataError);
+}
+
+TEST(GuiRunData, LoadsTumFilesAndComputesMetrics) {
+  const fs::path dir = test::writeTumRun("tum_run");
+  const RunData run = loadRun(dir.string());
+  EXPECT_EQ(fs::path(run.poses_from), dir / "truth.tum");
+  EXPECT_TRUE(run.metrics_from.empty());
+  EXPECT_DOUBLE_EQ(run.t0_s, test::kT0);
+
+  ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kTruthPoses));
+  EXPECT_NEAR(run.truth.x_m.back(), 100.0, 1e-9);  // 10 m/s for 10 s
+  EXPECT_NEAR(run.truth.y_m.back(), 50.0, 1e-9);
+  EXPECT_NEAR(run.truth.z_m.back(), -100.0, 1e-9);
+  EXPECT_NEAR(run.truth.roll_deg[7], test::kRollDeg, 1e-9);
+  EXPECT_NEAR(run.truth.pitch_deg[7], test::kPitchDeg, 1e-9);
+  EXPECT_NEAR(run.truth.yaw_deg[7], test::kYawDeg, 1e-9);
+
+  ASSERT_EQ(run.sources.size(), 1u);
+  const SourceSeries& source = run.sources.at("vo_test");
+  ASSERT_EQ(source.pose.size(), static_cast<std::size_t>(kEstimates));
+  ASSERT_EQ(source.position_error_m.size(), static_cast<std::size_t>(kEstimates));
+  for (int j = 0; j < kEstimates; ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    EXPECT_EQ(source.status[i], SourceEstimate::kTracking);
+    EXPECT_NEAR(source.position_error_m[i], 5.0, 1e-9) << j;  // |(3, 4, 0)|
+    EXPECT_NEAR(source.pose.yaw_deg[i], test::kYawDeg, 1e-9);
+  }
+  // At t = 100.5 s the truth is at (5, 2.5, -100); the estimate 3 m north, 4 m east.
+  EXPECT_NEAR(source.pose.x_m.front(), 8.0, 1e-9);
+  EXPECT_NEAR(source.pose.y_m.front(), 6.5, 1e-9);
+
+  const eval::SourceMetrics& m = run.metrics.sources.at("vo_test");
+  EXPECT_NEAR(m.position_rmse_m, 5.0, 1e-9);
+  EXPECT_NEAR(m.rotation_rmse_deg, 0.0, 1e-6);
+  // Tracked from the first estimate (0.5 s) until the last one's period ends (10 s).
+  EXPECT_NEAR(m.tracked_pct, 95.0, 1e-9);
+}
+
+TEST(GuiRunData, LoadsTheLogWithStatuses) {
+  const fs::path dir = writeLogRun("log_run");
+  // A truth.tum that disagrees shows which file the poses came from.
+  writeText(dir / "truth.tum", "0 1 2 3 0 0 0 1\n");
+  const RunData run = loadRun(dir.string());
+  EXPECT_EQ(fs::path(run.poses_from), dir / "run.lcmlog");
+  EXPECT_TRUE(run.damage.empty()) << run.damage;
+  ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kTruthPoses));
+  const SourceSeries& source = run.sources.at("vo_feature");
+  ASSERT_EQ(source.status.size(), static_cast<std::size_t>(kEstimates));
+  for (int j = 0; j < kEstimates; ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    if (j == kLostEstimate) {
+      EXPECT_EQ(source.status[i], SourceEstimate::kLost);
+      EXPECT_TRUE(std::isnan(source.position_error_m[i]));
+      EXPECT_TRUE(std::isnan(source.pose.x_m[i]));
+      EXPECT_TRUE(std::isnan(source.pose.roll_deg[i]));
+    } else {
+      EXPECT_EQ(source.status[i], SourceEstimate::kTracking);
+      EXPECT_NEAR(source.position_error_m[i], 5.0, 1e-6) << j;  // utime rounds to 1 us
+    }
+  }
+  EXPECT_NEAR(run.metrics.sources.at("vo_feature").position_rmse_m, 5.0, 1e-6);
+}
+
+TEST(GuiRunData, MetricsComeFromMetricsJson) {
+  const fs::path dir = test::writeTumRun("json_run");
+  eval::RunMetrics metrics;
+  metrics.truth_poses = 101;
+  eval::SourceMetrics m;
+  m.position_rmse_m = 7.5;  // not what the poses give: the file wins
+  m.rotation_rmse_deg = 0.25;
+  m.tracked_pct = 87.5;
+  m.ape_translation_m.rmse = 6.125;
+  metrics.sources["vo_test"] = m;
+  eval::EvalOptions options;
+  options.truth_max_gap_s = 0.75;
+  eval::writeMetricsJson((dir / "metrics.json").string(), metrics, options);
+
+  const RunData run = loadRun(dir.string());
+  EXPECT_EQ(fs::path(run.metrics_from), dir / "metrics.json");
+  EXPECT_DOUBLE_EQ(run.options.truth_max_gap_s, 0.75);
+  EXPECT_DOUBLE_EQ(run.metrics.sources.at("vo_test").position_rmse_m, 7.5);
+  // RPE was never set: it does not exist and its field is empty.
+  EXPECT_EQ(resultsCsv(run.metrics),
+            "source,position_rmse_m,rotation_rmse_deg,tracked_pct,ape_rmse_m,rpe_rmse_m\n"
+            "vo_test,7.5,0.25,87.5,6.125,\n");
+}
+
+// The message of the error thrown by loadRun(dir), or "" if it did not throw.
+std::string loadError(const fs::path& dir) {
+  try {
+    loadRun(dir.string());
+  } catch (const RunDataError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(GuiRunData, RefusesADamagedTumFileNamingIt) {
+  const fs::path dir = test::writeTumRun("bad_tum");
+  writeText(dir / "vo_bad.tum", "100.5 1 2 3 0 0 0 1\n100.6 1 two 3 0 0 0 1\n");
+  const std::string message = loadError(dir);
+  EXPECT_NE(message.find("vo_bad.tum"), std::string::npos) << message;
+  EXPECT_NE(message.find(":2"), std::string::npos) << message;  // the line
+}
+
+TEST(GuiRunData, RefusesForeignAndMissingFiles) {
+  const fs::path foreign_json = test::writeTumRun("foreign_json");
+  writeText(foreign_json / "metrics.json", R"({"schema": "something.else", "version": 1})");
+  std::string message = loadError(foreign_json);
+  EXPECT_NE(message.find("metrics.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("schema"), std::string::npos) << message;
+
+  const fs::path foreign_log = test::freshDir("foreign_log");
+  writeText(foreign_log / "run.lcmlog", "this is not an LCM log\n");
+  message = loadError(foreign_log);
+  EXPECT_NE(message.find("run.lcmlog"), std::string::npos) << message;
+
+  const fs::path empty_truth = test::freshDir("empty_truth");
+  writeText(empty_truth / "truth.tum", "# nothing\n");
+  message = loadError(empty_truth);
+  EXPECT_NE(message.find("truth.tum"), std::string::npos) << message;
+
+  const fs::path one_pose = test::freshDir("one_pose");
+  writeText(one_pose / "truth.tum", "0 1 2 3 0 0 0 1\n");
+  writeText(one_pose / "vo_test.tum", "0 1 2 3 0 0 0 1\n");  // a source: too few to compare
+  message = loadError(one_pose);
+  EXPECT_NE(message.find("truth.tum"), std::string::npos) << message;
+
+  const fs::path metrics_only = test::freshDir("metrics_only");
+  eval::writeMetricsJson((metrics_only / "metrics.json").string(), eval::RunMetrics{},
+                         eval::EvalOptions{});
+  message = loadError(metrics_only);
+  EXPECT_NE(message.find("truth.tum"), std::string::npos) << message;
+
+  message = loadError(test::freshDir("x") / "missing");
+  EXPECT_NE(message.find("not a directory"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace nadir::gui
