@@ -29,7 +29,8 @@ void addEvalCommand(CLI::App& app);
 // nadir run's and nadir demo's progress line, on stderr, and its end.
 void printRunProgress(const run::RunProgress& progress);
 void endRunProgress();
-// The results table and the files a run wrote.
-void printRunResult(const run::RunResult& result);
+// The results table and the files a run wrote; then the run's charts
+// (nadir-plot --headless into RUN_DIR/plots) and where they are.
+void finishRun(const run::RunResult& result);
 
 }  // namespace nadir::cli

@@ -21,7 +21,7 @@ int runDemo(const std::string& out_dir) {
   options.force = true;
   const run::RunResult result = run::runScenario(options, printRunProgress);
   endRunProgress();
-  printRunResult(result);
+  finishRun(result);
   std::cout << "\nNext: `./nadir run SCENARIO` (./nadir sim --list shows them), `./nadir eval "
             << out_dir << "`,\n`./nadir export " << out_dir
             << " --format euroc`, and `./nadir doctor` before live `./nadir launch`.\n";

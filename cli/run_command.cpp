@@ -29,12 +29,16 @@ void endRunProgress() {
   if (isatty(STDERR_FILENO) != 0) std::fprintf(stderr, "\n");
 }
 
-void printRunResult(const run::RunResult& result) {
+void finishRun(const run::RunResult& result) {
   std::cout << "\n" << result.table << "\n";
   std::cout << "wrote " << result.log_path << " (replay: lcm-logplayer " << result.log_path
             << ")\n      " << result.metrics_path << "\n";
   for (const std::string& path : result.tum_paths) std::cout << "      " << path << "\n";
   for (const std::string& path : result.picture_paths) std::cout << "      " << path << "\n";
+  std::cout << std::flush;
+  const run::RunPlots plots = run::renderRunPlots(result.out_dir);
+  for (const std::string& path : plots.png_paths) std::cout << "      " << path << "\n";
+  if (!plots.problem.empty()) std::cerr << "nadir run: " << plots.problem << "\n";
 }
 
 void addRunCommand(CLI::App& app) {
@@ -53,7 +57,7 @@ void addRunCommand(CLI::App& app) {
   command->callback([options] {
     const run::RunResult result = run::runScenario(*options, printRunProgress);
     endRunProgress();
-    printRunResult(result);
+    finishRun(result);
   });
 }
 

@@ -64,6 +64,13 @@ SourceSeries sourceSeries(const eval::PoseTrajectory& truth,
     const std::optional<eval::StampedPose> reference =
         eval::interpolate(truth, e.t_s, truth_max_gap_s);
     series.position_error_m.push_back(reference ? (e.p_m - reference->p_m).norm() : kNaN);
+    if (reference) {
+      // The yaw on the truth's side of +-180 deg, so that a heading near south is
+      // drawn beside the truth's rather than a full turn away.
+      const double truth_yaw_deg = core::rpyFromQuaternion(reference->q).yaw_rad * kDegPerRad;
+      double& yaw_deg = series.pose.yaw_deg.back();
+      yaw_deg += 360.0 * std::round((truth_yaw_deg - yaw_deg) / 360.0);
+    }
   }
   return series;
 }

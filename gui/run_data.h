@@ -39,6 +39,8 @@ struct PoseSeries {
 };
 
 struct SourceSeries {
+  // Yaw is taken on the truth's side of +-180 deg where the truth has a pose (so it
+  // may lie outside [-180, 180]): a heading near south is drawn beside the truth's.
   PoseSeries pose;
   std::vector<int> status;  // eval::SourceEstimate::kInitializing, kTracking, kLost
   // |p_est - p_truth| with the truth interpolated at the estimate's stamp, m; NaN

@@ -41,12 +41,6 @@ std::string programPath(const std::string& bin_dir, const std::string& name) {
   return path.string();
 }
 
-std::string selfDirectory() {
-  std::error_code error;
-  const fs::path self = fs::read_symlink("/proc/self/exe", error);
-  return error ? std::string(".") : self.parent_path().string();
-}
-
 struct ChannelHealth {
   std::int64_t total = 0;
   std::int64_t window = 0;

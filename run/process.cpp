@@ -8,12 +8,19 @@
 
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <thread>
 
 extern char** environ;
 
 namespace nadir::run {
+
+std::string selfDirectory() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::string(".") : self.parent_path().string();
+}
 
 ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv, std::string log_path)
     : name_(std::move(name)), argv_(std::move(argv)), log_path_(std::move(log_path)) {}

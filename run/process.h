@@ -9,6 +9,9 @@
 
 namespace nadir::run {
 
+// The folder of the running program (where its sibling programs are); "." if unknown.
+std::string selfDirectory();
+
 class ChildProcess {
  public:
   ChildProcess(std::string name, std::vector<std::string> argv, std::string log_path);

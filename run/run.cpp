@@ -1,5 +1,6 @@
 #include "run/run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "core/bus.h"
 #include "core/clock.h"
@@ -19,6 +21,7 @@
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
 #include "nodes/vo_feature/vo_feature_node.h"
+#include "run/process.h"
 #include "run/target_passes.h"
 #include "run/track_plot.h"
 #include "scenario/scenario.h"
@@ -166,6 +169,41 @@ RunResult runScenario(const RunOptions& options,
     std::ofstream(out / "target_passes.csv") << targetPassesCsv(result.target_passes);
   }
   return result;
+}
+
+RunPlots renderRunPlots(const std::string& run_dir) {
+  RunPlots plots;
+  const fs::path program = fs::path(selfDirectory()) / "nadir-plot";
+  if (!fs::exists(program)) {
+    plots.problem = "no plots: " + program.string() + " is not built";
+    return plots;
+  }
+  const fs::path out = fs::path(run_dir) / "plots";
+  std::error_code error;
+  fs::create_directories(out, error);
+  if (error) {
+    plots.problem = "no plots: cannot create " + out.string() + ": " + error.message();
+    return plots;
+  }
+  ChildProcess plotter("nadir-plot",
+                       {program.string(), "--headless", run_dir, "--out", out.string()},
+                       (out / "nadir-plot.log").string());
+  try {
+    plotter.start();
+  } catch (const std::exception& failure) {
+    plots.problem = std::string("no plots: ") + failure.what();
+    return plots;
+  }
+  while (plotter.running()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (plotter.exitStatus() != 0) {
+    plots.problem =
+        "no plots: nadir-plot ended with " + plotter.describeExit() + ", see " + plotter.logPath();
+    return plots;
+  }
+  for (const auto& entry : fs::directory_iterator(out))
+    if (entry.path().extension() == ".png") plots.png_paths.push_back(entry.path().string());
+  std::sort(plots.png_paths.begin(), plots.png_paths.end());
+  return plots;
 }
 
 }  // namespace nadir::run

@@ -58,4 +58,14 @@ struct RunResult {
 RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress = {});
 
+struct RunPlots {
+  std::vector<std::string> png_paths;  // what nadir-plot wrote into RUN_DIR/plots
+  std::string problem;                 // why there are none; empty when it worked
+};
+// The run's charts: nadir-plot --headless (the program beside this one; Qt stays
+// in gui/) into run_dir/plots, its output in run_dir/plots/nadir-plot.log. A
+// missing or failing nadir-plot is reported in `problem`, not thrown: the run
+// itself is done.
+RunPlots renderRunPlots(const std::string& run_dir);
+
 }  // namespace nadir::run

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -176,6 +177,28 @@ std::string loadError(const fs::path& dir) {
     return error.what();
   }
   return "";
+}
+
+// Headings either side of south: the truth flies at yaw 179.5 deg and the
+// estimate reads -179.5 deg (1 deg off); the estimate's yaw is given as 180.5 deg,
+// beside the truth's, not a full turn away.
+TEST(GuiRunData, EstimateYawIsDrawnOnTheTruthsSideOfSouth) {
+  constexpr double kRad = std::numbers::pi / 180.0;
+  const fs::path dir = test::freshDir("south");
+  eval::PoseTrajectory truth, estimate;
+  for (int k = 0; k < 11; ++k) {
+    const double t = 100.0 + 0.1 * k;
+    truth.push_back(
+        {t, Eigen::Vector3d(0, 0, -100), core::quaternionFromRpy({0, 0, 179.5 * kRad})});
+    estimate.push_back(
+        {t, Eigen::Vector3d(0, 0, -100), core::quaternionFromRpy({0, 0, -179.5 * kRad})});
+  }
+  eval::writeTum((dir / "truth.tum").string(), truth);
+  eval::writeTum((dir / "vo_test.tum").string(), estimate);
+  const RunData run = loadRun(dir.string());
+  const SourceSeries& vo = run.sources.at("vo_test");
+  ASSERT_EQ(vo.pose.size(), 11u);
+  for (double yaw_deg : vo.pose.yaw_deg) EXPECT_NEAR(yaw_deg, 180.5, 1e-6);
 }
 
 TEST(GuiRunData, RefusesADamagedTumFileNamingIt) {

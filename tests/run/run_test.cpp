@@ -65,6 +65,27 @@ TEST(Run, WritesItsFiles) {
   EXPECT_NEAR(result.metrics.truth_track_length_m, 3.0 * 20.0, 0.5);  // 20 m/s airspeed, no wind
 }
 
+// Every run gets its charts: nadir-plot (built beside the test, as beside nadir)
+// writes the four figures into RUN_DIR/plots; a folder that holds no run gives a
+// problem naming the failure instead of an exception.
+TEST(Run, RenderRunPlotsWritesTheCharts) {
+  const RunResult result = runScenario(shortRun(tempDir("plots")));
+  const RunPlots plots = renderRunPlots(result.out_dir);
+  EXPECT_TRUE(plots.problem.empty()) << plots.problem;
+  std::vector<std::string> names;
+  for (const std::string& path : plots.png_paths) names.push_back(fs::path(path).filename());
+  EXPECT_EQ(names, (std::vector<std::string>{"attitude.png", "error.png", "position.png",
+                                             "top_view.png"}));
+  for (const std::string& path : plots.png_paths) EXPECT_GT(fs::file_size(path), 10000u) << path;
+
+  const std::string empty = tempDir("plots_of_nothing");
+  fs::create_directories(empty);
+  const RunPlots none = renderRunPlots(empty);
+  EXPECT_TRUE(none.png_paths.empty());
+  EXPECT_NE(none.problem.find("nadir-plot ended with exit status 1"), std::string::npos)
+      << none.problem;
+}
+
 // Two runs of one scenario produce byte-identical logs.
 TEST(Run, TwoRunsGiveIdenticalLogs) {
   const RunResult a = runScenario(shortRun(tempDir("same_a")));
