@@ -1,6 +1,8 @@
-// nadir-plot: the plot viewer. --headless renders a run's charts to PNG files
-// and its error table to results.csv; the interactive viewer is not built yet.
+// nadir-plot: the plot viewer. Without --headless, a window on the runs under DIR
+// (default: out if it exists, else the current folder); --headless renders a
+// run's charts to PNG files and its error table to results.csv.
 //
+//   nadir-plot [DIR]
 //   nadir-plot --headless RUN_DIR --out DIR
 //
 // RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
@@ -18,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/plot_window.h"
 #include "gui/plots.h"
 #include "gui/run_data.h"
 
@@ -65,17 +68,30 @@ int main(int argc, char** argv) {
   std::string out_dir;
   bool headless = false;
   app.add_option("run_dir", run_dir,
-                 "a run directory (as `nadir run` writes it), or a tree of runs")
-      ->required();
+                 "a run directory (as `nadir run` writes it), or a tree of runs; without "
+                 "--headless, default out if it exists, else the current directory");
   app.add_flag("--headless", headless, "render PNG files and results.csv instead of a window");
   app.add_option("--out", out_dir, "where --headless writes its files");
   CLI11_PARSE(app, argc, argv);
 
   if (!headless) {
-    std::fprintf(stderr,
-                 "nadir-plot: the interactive viewer is not built yet; use --headless RUN_DIR "
-                 "--out DIR\n");
-    return 2;
+    if (!out_dir.empty()) {
+      std::fprintf(stderr, "nadir-plot: --out is for --headless\n");
+      return 1;
+    }
+    if (run_dir.empty()) run_dir = fs::is_directory("out") ? "out" : ".";
+    if (!fs::is_directory(run_dir)) {
+      std::fprintf(stderr, "nadir-plot: %s: not a directory\n", run_dir.c_str());
+      return 1;
+    }
+    QApplication application(argc, argv);
+    nadir::gui::PlotWindow window(QString::fromStdString(run_dir));
+    window.show();
+    return QApplication::exec();
+  }
+  if (run_dir.empty()) {
+    std::fprintf(stderr, "nadir-plot: --headless needs RUN_DIR\n");
+    return 1;
   }
   if (out_dir.empty()) {
     std::fprintf(stderr, "nadir-plot: --headless needs --out DIR\n");

@@ -1,0 +1,474 @@
+#include "gui/plot_window.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QChart>
+#include <QChartView>
+#include <QDir>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QHeaderView>
+#include <QImage>
+#include <QKeySequence>
+#include <QLabel>
+#include <QLegend>
+#include <QLegendMarker>
+#include <QMenuBar>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QSvgGenerator>
+#include <QTabWidget>
+#include <QTableWidget>
+#include <QToolBar>
+#include <QTreeWidget>
+#include <QVBoxLayout>
+#include <QWheelEvent>
+
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gui/plots.h"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kPathRole = Qt::UserRole;
+
+// A chart view that zooms with a rubber band and the wheel, pans with the middle
+// button (or Shift and the left button) and the arrow keys, and resets on Home
+// or 0. Right click zooms back out one step (QChartView's rubber band does it).
+class ZoomChartView : public QChartView {
+ public:
+  explicit ZoomChartView(QChart* chart) : QChartView(chart) {
+    setRenderHint(QPainter::Antialiasing);
+    setRubberBand(QChartView::RectangleRubberBand);
+    setFocusPolicy(Qt::StrongFocus);
+  }
+
+ protected:
+  void wheelEvent(QWheelEvent* event) override {
+    const int delta = event->angleDelta().y();
+    if (delta == 0) return;
+    // The point under the cursor stays put.
+    const double factor = delta > 0 ? 0.8 : 1.25;
+    const QRectF area = chart()->plotArea();
+    const QPointF at = chart()->mapFromScene(mapToScene(event->position().toPoint()));
+    if (!area.contains(at)) return;
+    const QPointF from = at - (at - area.topLeft()) * factor;
+    chart()->zoomIn(QRectF(from, area.size() * factor));
+    event->accept();
+  }
+
+  void mousePressEvent(QMouseEvent* event) override {
+    if (isPanButton(event)) {
+      panning_ = true;
+      last_ = event->position();
+      setCursor(Qt::ClosedHandCursor);
+      event->accept();
+      return;
+    }
+    QChartView::mousePressEvent(event);
+  }
+
+  void mouseMoveEvent(QMouseEvent* event) override {
+    if (panning_) {
+      const QPointF delta = event->position() - last_;
+      last_ = event->position();
+      chart()->scroll(-delta.x(), delta.y());
+      event->accept();
+      return;
+    }
+    QChartView::mouseMoveEvent(event);
+  }
+
+  void mouseReleaseEvent(QMouseEvent* event) override {
+    if (panning_) {
+      panning_ = false;
+      unsetCursor();
+      event->accept();
+      return;
+    }
+    QChartView::mouseReleaseEvent(event);
+  }
+
+  void keyPressEvent(QKeyEvent* event) override {
+    constexpr double kStep = 20;  // px
+    switch (event->key()) {
+      case Qt::Key_Left:
+        chart()->scroll(-kStep, 0);
+        break;
+      case Qt::Key_Right:
+        chart()->scroll(kStep, 0);
+        break;
+      case Qt::Key_Up:
+        chart()->scroll(0, kStep);
+        break;
+      case Qt::Key_Down:
+        chart()->scroll(0, -kStep);
+        break;
+      case Qt::Key_Plus:
+      case Qt::Key_Equal:
+        chart()->zoomIn();
+        break;
+      case Qt::Key_Minus:
+        chart()->zoomOut();
+        break;
+      case Qt::Key_Home:
+      case Qt::Key_0:
+        chart()->zoomReset();
+        break;
+      default:
+        QChartView::keyPressEvent(event);
+        return;
+    }
+    event->accept();
+  }
+
+ private:
+  static bool isPanButton(const QMouseEvent* event) {
+    return event->button() == Qt::MiddleButton ||
+           (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ShiftModifier));
+  }
+
+  bool panning_ = false;
+  QPointF last_;
+};
+
+QWidget* interactiveFigure(Figure figure) {
+  auto* widget = new QWidget;
+  auto* layout = new QVBoxLayout(widget);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->setSpacing(0);
+  for (std::unique_ptr<QChart>& chart : figure.charts) {
+    makeLegendToggleable(chart.get());
+    layout->addWidget(new ZoomChartView(chart.release()));
+  }
+  return widget;
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+bool writeFile(const QString& path, const QByteArray& bytes) {
+  QFile file(path);
+  return file.open(QIODevice::WriteOnly | QIODevice::Truncate) &&
+         file.write(bytes) == bytes.size() && file.flush();
+}
+
+}  // namespace
+
+void makeLegendToggleable(QChart* chart) {
+  for (QLegendMarker* marker : chart->legend()->markers()) {
+    QObject::connect(marker, &QLegendMarker::clicked, chart, [chart, marker] {
+      QAbstractSeries* clicked = marker->series();
+      const bool visible = !clicked->isVisible();
+      for (QAbstractSeries* series : chart->series()) {
+        if (series->name() != clicked->name()) continue;
+        series->setVisible(visible);
+        // Showing a series shows its markers: only the clicked one is listed.
+        for (QLegendMarker* other : chart->legend()->markers(series)) {
+          other->setVisible(other == marker);
+        }
+      }
+      QBrush label = marker->labelBrush();
+      QColor color = label.color();
+      color.setAlphaF(visible ? 1.0 : 0.4);
+      label.setColor(color);
+      marker->setLabelBrush(label);
+    });
+  }
+}
+
+PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(parent) {
+  setWindowTitle("nadir-plot");
+  resize(1400, 900);
+
+  tree_ = new QTreeWidget;
+  tree_->setHeaderLabel("runs");
+  tree_->setSelectionMode(QAbstractItemView::SingleSelection);
+  tabs_ = new QTabWidget;
+  message_ = new QLabel;
+  message_->setWordWrap(true);
+  message_->setAlignment(Qt::AlignCenter);
+  message_->hide();
+  table_ = new QTableWidget;
+  table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  table_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  table_->verticalHeader()->hide();
+
+  auto* figures = new QWidget;
+  auto* figures_layout = new QVBoxLayout(figures);
+  figures_layout->setContentsMargins(0, 0, 0, 0);
+  figures_layout->addWidget(tabs_);
+  figures_layout->addWidget(message_);
+  auto* right = new QSplitter(Qt::Vertical);
+  right->addWidget(figures);
+  right->addWidget(table_);
+  right->setStretchFactor(0, 5);
+  right->setStretchFactor(1, 1);
+  right->setSizes({720, 140});  // else the table's size hint takes half
+  auto* split = new QSplitter(Qt::Horizontal);
+  split->addWidget(tree_);
+  split->addWidget(right);
+  split->setStretchFactor(0, 1);
+  split->setStretchFactor(1, 5);
+  split->setSizes({220, 1180});
+  setCentralWidget(split);
+
+  QMenu* file = menuBar()->addMenu("&File");
+  QToolBar* tools = addToolBar("tools");
+  const auto action = [&](QMenu* menu, const QString& text, const QKeySequence& keys, auto&& slot) {
+    QAction* added = menu->addAction(text);
+    added->setShortcut(keys);
+    connect(added, &QAction::triggered, this, slot);
+    tools->addAction(added);
+    return added;
+  };
+  action(file, "&Open folder...", QKeySequence::Open, [this] { chooseRoot(); });
+  action(file, "Export figure &PNG...", QKeySequence("Ctrl+E"),
+         [this] { chooseFigureExport("png"); });
+  action(file, "Export figure &SVG...", QKeySequence("Ctrl+Shift+E"),
+         [this] { chooseFigureExport("svg"); });
+  action(file, "Export table &CSV...", QKeySequence("Ctrl+T"), [this] { chooseTableExport(); });
+  file->addSeparator();
+  QAction* quit = file->addAction("&Quit");
+  quit->setShortcut(QKeySequence::Quit);
+  connect(quit, &QAction::triggered, this, &QWidget::close);
+  QMenu* view = menuBar()->addMenu("&View");
+  action(view, "&Reset zoom", QKeySequence("Ctrl+0"), [this] { resetZoom(); });
+
+  connect(tree_, &QTreeWidget::currentItemChanged, this,
+          [this](QTreeWidgetItem* item, QTreeWidgetItem*) {
+            if (item != nullptr) loadRunAt(item->data(0, kPathRole).toString());
+          });
+
+  openRoot(root);
+}
+
+PlotWindow::~PlotWindow() = default;
+
+bool PlotWindow::openRoot(const QString& root) {
+  tree_->blockSignals(true);
+  tree_->clear();
+  tree_->blockSignals(false);
+  clearRun();
+  root_ = root;
+  std::vector<std::string> runs;
+  try {
+    runs = findRuns(root.toStdString());
+  } catch (const std::exception& error) {
+    fail(QString::fromStdString(error.what()));
+    return false;
+  }
+  setWindowTitle("nadir-plot: " + QDir(root).absolutePath());
+  for (const std::string& run : runs) {
+    const fs::path relative = fs::path(run).lexically_relative(root.toStdString());
+    auto* item = new QTreeWidgetItem(tree_, {QString::fromStdString(relative.string())});
+    item->setData(0, kPathRole, QString::fromStdString(run));
+  }
+  last_error_.clear();
+  // The first run is shown at once: a single run needs no click.
+  if (tree_->topLevelItemCount() > 0) {
+    tree_->setCurrentItem(tree_->topLevelItem(0));
+    if (!run_) return true;  // its error is in the status bar
+  }
+  statusBar()->showMessage(runs.empty() ? root +
+                                              ": no run here (a run is a folder with "
+                                              "run.lcmlog, truth.tum or metrics.json)"
+                                        : QString("%1 runs under %2").arg(runs.size()).arg(root));
+  return true;
+}
+
+bool PlotWindow::selectRun(const QString& relative) {
+  const QList<QTreeWidgetItem*> found = tree_->findItems(relative, Qt::MatchExactly);
+  if (found.isEmpty()) {
+    fail(root_ + ": no run " + relative);
+    return false;
+  }
+  if (tree_->currentItem() == found.front()) {
+    loadRunAt(found.front()->data(0, kPathRole).toString());
+  } else {
+    tree_->setCurrentItem(found.front());
+  }
+  return run_.has_value();
+}
+
+void PlotWindow::loadRunAt(const QString& dir) {
+  clearRun();
+  try {
+    run_ = loadRun(dir.toStdString());
+  } catch (const std::exception& error) {
+    fail(QString::fromStdString(error.what()));
+    return;
+  }
+  last_error_.clear();
+  showRun();
+}
+
+void PlotWindow::clearRun() {
+  run_.reset();
+  while (tabs_->count() > 0) {
+    QWidget* page = tabs_->widget(0);
+    tabs_->removeTab(0);
+    delete page;
+  }
+  table_->clear();
+  table_->setRowCount(0);
+  table_->setColumnCount(0);
+  message_->hide();
+  tabs_->show();
+}
+
+void PlotWindow::showRun() {
+  for (Figure& figure : buildFigures(*run_)) {
+    const QString name = QString::fromStdString(figure.name);
+    tabs_->addTab(interactiveFigure(std::move(figure)), name);
+  }
+  // The table shows resultsCsv's text, so it holds the numbers of metrics.json
+  // (and of an export) exactly.
+  std::istringstream csv(resultsCsv(run_->metrics));
+  std::string line;
+  std::getline(csv, line);  // the header: the columns below say it with units
+  table_->setColumnCount(6);
+  table_->setHorizontalHeaderLabels({"source", "position RMSE (m)", "rotation RMSE (deg)",
+                                     "tracked (%)", "APE RMSE (m)", "RPE RMSE (m)"});
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> fields = splitCsvLine(line);
+    const int row = table_->rowCount();
+    table_->insertRow(row);
+    for (int column = 0; column < 6 && column < static_cast<int>(fields.size()); ++column) {
+      auto* cell = new QTableWidgetItem(QString::fromStdString(fields[column]));
+      if (column > 0) cell->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+      table_->setItem(row, column, cell);
+    }
+  }
+  QString status =
+      QString::fromStdString(run_->dir) + ": poses from " +
+      QString::fromStdString(run_->poses_from) + ", metrics " +
+      (run_->metrics_from.empty() ? QString("computed here")
+                                  : "from " + QString::fromStdString(run_->metrics_from));
+  if (!run_->damage.empty()) {
+    status += "; damaged, showing what could be read: " + QString::fromStdString(run_->damage);
+  }
+  statusBar()->showMessage(status);
+}
+
+void PlotWindow::fail(const QString& message) {
+  last_error_ = message;
+  statusBar()->showMessage(message);
+  if (!run_) {
+    tabs_->hide();
+    message_->setText(message);
+    message_->show();
+  }
+}
+
+bool PlotWindow::exportFigure(const QString& path) {
+  QWidget* figure = tabs_->currentWidget();
+  if (!run_ || figure == nullptr) {
+    fail("no figure to export: select a run first");
+    return false;
+  }
+  // A window never shown has no layout yet: lay it out without showing it.
+  const bool hidden = !isVisible();
+  if (hidden) {
+    setAttribute(Qt::WA_DontShowOnScreen, true);
+    show();
+  }
+  for (int i = 0; i < 3; ++i) QApplication::processEvents();
+  const QSize size = figure->size();
+  bool written = false;
+  if (QFileInfo(path).suffix().compare("svg", Qt::CaseInsensitive) == 0) {
+    QSvgGenerator svg;
+    svg.setFileName(path);
+    svg.setSize(size);
+    svg.setViewBox(QRect(QPoint(0, 0), size));
+    svg.setTitle(tabs_->tabText(tabs_->currentIndex()));
+    QPainter painter;
+    if (painter.begin(&svg)) {
+      figure->render(&painter);
+      written = painter.end();
+    }
+    written = written && QFileInfo(path).size() > 0;
+  } else {
+    QImage image(size, QImage::Format_RGB32);
+    image.fill(Qt::white);
+    QPainter painter(&image);
+    figure->render(&painter);
+    painter.end();
+    written = image.save(path, "PNG");
+  }
+  if (hidden) {
+    hide();
+    setAttribute(Qt::WA_DontShowOnScreen, false);
+  }
+  if (!written) {
+    fail(path + ": cannot write the file");
+    return false;
+  }
+  last_error_.clear();
+  statusBar()->showMessage("wrote " + path);
+  return true;
+}
+
+bool PlotWindow::exportTableCsv(const QString& path) {
+  if (!run_) {
+    fail("no table to export: select a run first");
+    return false;
+  }
+  if (!writeFile(path, QByteArray::fromStdString(resultsCsv(run_->metrics)))) {
+    fail(path + ": cannot write the file");
+    return false;
+  }
+  last_error_.clear();
+  statusBar()->showMessage("wrote " + path);
+  return true;
+}
+
+void PlotWindow::resetZoom() {
+  for (QChartView* view : tabs_->findChildren<QChartView*>()) view->chart()->zoomReset();
+}
+
+void PlotWindow::chooseRoot() {
+  const QString dir = QFileDialog::getExistingDirectory(this, "Open a folder of runs", root_);
+  if (!dir.isEmpty()) openRoot(dir);
+}
+
+void PlotWindow::chooseFigureExport(const QString& suffix) {
+  if (!run_) {
+    fail("no figure to export: select a run first");
+    return;
+  }
+  const QString suggested = QDir(QString::fromStdString(run_->dir))
+                                .filePath(tabs_->tabText(tabs_->currentIndex()) + "." + suffix);
+  const QString path = QFileDialog::getSaveFileName(this, "Export the figure", suggested,
+                                                    suffix.toUpper() + " (*." + suffix + ")");
+  if (!path.isEmpty()) exportFigure(path);
+}
+
+void PlotWindow::chooseTableExport() {
+  if (!run_) {
+    fail("no table to export: select a run first");
+    return;
+  }
+  const QString suggested = QDir(QString::fromStdString(run_->dir)).filePath("results.csv");
+  const QString path =
+      QFileDialog::getSaveFileName(this, "Export the error table", suggested, "CSV (*.csv)");
+  if (!path.isEmpty()) exportTableCsv(path);
+}
+
+}  // namespace nadir::gui

@@ -1,0 +1,275 @@
+// The interactive window under Qt's offscreen platform: the runs it lists, the
+// table against the run's metrics, the figures, legend toggling, zoom, exports,
+// and a damaged run that must not take the window down.
+
+#include "gui/plot_window.h"
+
+#include <QApplication>
+#include <QChart>
+#include <QChartView>
+#include <QColor>
+#include <QImage>
+#include <QLegend>
+#include <QLegendMarker>
+#include <QTabWidget>
+#include <QTableWidget>
+#include <QTreeWidget>
+#include <QValueAxis>
+#include <QWheelEvent>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "gui/plots.h"
+#include "gui_test_util.h"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+class GuiPlotWindow : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (QApplication::instance() != nullptr) return;
+    setenv("QT_QPA_PLATFORM", "offscreen", 1);
+    static int argc = 1;
+    static char name[] = "gui_window_test";
+    static char* argv[] = {name, nullptr};
+    // Never destroyed: Qt must outlive every test, and ends with the process.
+    new QApplication(argc, argv);
+  }
+
+  // root/computed (metrics from the poses), root/json (metrics.json, no RPE) and
+  // root/sub/bad (a truth.tum that does not parse).
+  static fs::path makeRoot() {
+    const fs::path root = test::freshDir("window_root");
+    const fs::path source = test::writeTumRun("window_source");
+    fs::copy(source, root / "computed");
+    fs::copy(source, root / "json");
+    eval::RunMetrics metrics;
+    metrics.truth_poses = 101;
+    eval::SourceMetrics m;
+    m.position_rmse_m = 0.1 + 0.2;  // not short in decimal: the table must keep every digit
+    m.rotation_rmse_deg = 0.25;
+    m.tracked_pct = 87.5;
+    m.ape_translation_m.rmse = 6.125;
+    metrics.sources["vo_test"] = m;
+    eval::writeMetricsJson((root / "json" / "metrics.json").string(), metrics, {});
+    fs::create_directories(root / "sub");
+    fs::copy(source, root / "sub" / "bad");
+    std::ofstream(root / "sub" / "bad" / "truth.tum", std::ios::app) << "oops\n";
+    return root;
+  }
+};
+
+void settle() {
+  for (int i = 0; i < 5; ++i) QApplication::processEvents();
+}
+
+// Every row of the table, parsed back, against the run's metrics.
+void expectTableMatches(const QTableWidget& table, const eval::RunMetrics& metrics) {
+  ASSERT_EQ(table.columnCount(), 6);
+  ASSERT_EQ(table.rowCount(), static_cast<int>(metrics.sources.size()));
+  int row = 0;
+  for (const auto& [name, m] : metrics.sources) {
+    ASSERT_NE(table.item(row, 0), nullptr);
+    EXPECT_EQ(table.item(row, 0)->text().toStdString(), name);
+    const double expected[] = {m.position_rmse_m, m.rotation_rmse_deg, m.tracked_pct,
+                               m.ape_translation_m.rmse, m.rpe_translation_m.rmse};
+    for (int column = 1; column < 6; ++column) {
+      const QTableWidgetItem* cell = table.item(row, column);
+      ASSERT_NE(cell, nullptr) << row << "," << column;
+      const std::string text = cell->text().toStdString();
+      const double value = expected[column - 1];
+      if (!std::isfinite(value)) {
+        EXPECT_TRUE(text.empty()) << column << ": " << text;
+      } else {
+        ASSERT_FALSE(text.empty()) << column;
+        EXPECT_EQ(std::stod(text), value) << column << ": " << text;  // exactly
+      }
+    }
+    ++row;
+  }
+}
+
+QChartView* firstChartView(QWidget* figure) {
+  const QList<QChartView*> views = figure->findChildren<QChartView*>();
+  return views.isEmpty() ? nullptr : views.front();
+}
+
+TEST_F(GuiPlotWindow, ListsTheRunsRelativeToTheRoot) {
+  const fs::path root = makeRoot();
+  PlotWindow window(QString::fromStdString(root.string()));
+  QTreeWidget* tree = window.runTree();
+  ASSERT_EQ(tree->topLevelItemCount(), 3);
+  EXPECT_EQ(tree->topLevelItem(0)->text(0), "computed");
+  EXPECT_EQ(tree->topLevelItem(1)->text(0), "json");
+  EXPECT_EQ(tree->topLevelItem(2)->text(0), "sub/bad");
+  // The first run is shown at once.
+  ASSERT_NE(window.run(), nullptr);
+  EXPECT_EQ(window.figureTabs()->count(), 4);
+
+  EXPECT_FALSE(window.openRoot(QString::fromStdString((root / "missing").string())));
+  EXPECT_FALSE(window.lastError().isEmpty());
+  EXPECT_EQ(tree->topLevelItemCount(), 0);
+}
+
+TEST_F(GuiPlotWindow, TableShowsTheRunsMetricsExactly) {
+  const fs::path root = makeRoot();
+  PlotWindow window(QString::fromStdString(root.string()));
+  for (const char* name : {"computed", "json"}) {
+    ASSERT_TRUE(window.selectRun(name)) << window.lastError().toStdString();
+    ASSERT_NE(window.run(), nullptr);
+    expectTableMatches(*window.errorTable(), window.run()->metrics);
+  }
+  // json: metrics.json's numbers, RPE absent.
+  EXPECT_EQ(window.errorTable()->item(0, 1)->text(), "0.30000000000000004");
+  EXPECT_TRUE(window.errorTable()->item(0, 5)->text().isEmpty());
+  EXPECT_DOUBLE_EQ(window.run()->metrics.sources.at("vo_test").tracked_pct, 87.5);
+}
+
+TEST_F(GuiPlotWindow, ShowsTheFiguresInTabs) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("computed"));
+  QTabWidget* tabs = window.figureTabs();
+  ASSERT_EQ(tabs->count(), 4);
+  const char* names[] = {"position", "attitude", "error", "top_view"};
+  const int charts[] = {3, 3, 1, 1};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(tabs->tabText(i), names[i]);
+    EXPECT_EQ(tabs->widget(i)->findChildren<QChartView*>().size(), charts[i]) << names[i];
+  }
+}
+
+TEST_F(GuiPlotWindow, ClickingALegendMarkerTogglesItsSeries) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("computed"));
+  window.show();  // a legend marker is visible only in a shown chart
+  settle();
+  QChartView* view = firstChartView(window.figureTabs()->widget(0));
+  ASSERT_NE(view, nullptr);
+  QChart* chart = view->chart();
+  QLegendMarker* marker = nullptr;
+  for (QLegendMarker* m : chart->legend()->markers()) {
+    if (m->label() == "vo_test" && m->isVisible()) marker = m;
+  }
+  ASSERT_NE(marker, nullptr);
+  const auto visibleSeries = [chart](bool visible) {
+    int count = 0;
+    for (QAbstractSeries* series : chart->series()) {
+      if (series->name() == "vo_test" && series->isVisible() == visible) ++count;
+    }
+    return count;
+  };
+  const int segments = visibleSeries(true);
+  ASSERT_GT(segments, 0);
+
+  emit marker->clicked();
+  EXPECT_EQ(visibleSeries(true), 0);
+  EXPECT_EQ(visibleSeries(false), segments);
+  EXPECT_TRUE(marker->isVisible());  // still there, to click again
+  for (QAbstractSeries* series : chart->series()) {
+    if (series->name() == "truth") {
+      EXPECT_TRUE(series->isVisible());
+    }
+  }
+
+  emit marker->clicked();
+  EXPECT_EQ(visibleSeries(true), segments);
+  int listed = 0;
+  for (QLegendMarker* m : chart->legend()->markers()) {
+    if (m->label() == "vo_test" && m->isVisible()) ++listed;
+  }
+  EXPECT_EQ(listed, 1);  // one entry, not one per segment
+}
+
+TEST_F(GuiPlotWindow, WheelZoomsAndResetRestores) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("computed"));
+  window.show();
+  settle();
+  QChartView* view = firstChartView(window.figureTabs()->widget(0));
+  ASSERT_NE(view, nullptr);
+  auto* x_axis = static_cast<QValueAxis*>(view->chart()->axes(Qt::Horizontal).front());
+  const double span = x_axis->max() - x_axis->min();
+  const QPointF center =
+      view->mapFromScene(view->chart()->mapToScene(view->chart()->plotArea().center()));
+  QWheelEvent wheel(center, view->mapToGlobal(center.toPoint()), QPoint(), QPoint(0, 120),
+                    Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(view->viewport(), &wheel);
+  EXPECT_LT(x_axis->max() - x_axis->min(), 0.9 * span);
+  window.resetZoom();
+  EXPECT_NEAR(x_axis->max() - x_axis->min(), span, 1e-9 * span);
+}
+
+TEST_F(GuiPlotWindow, ExportsTheFigureAndTheTable) {
+  const fs::path root = makeRoot();
+  const fs::path out = test::freshDir("window_out");
+  PlotWindow window(QString::fromStdString(root.string()));
+  ASSERT_TRUE(window.selectRun("json"));
+  window.figureTabs()->setCurrentIndex(3);  // top_view
+
+  const fs::path png = out / "top_view.png";
+  ASSERT_TRUE(window.exportFigure(QString::fromStdString(png.string())))
+      << window.lastError().toStdString();
+  EXPECT_GT(fs::file_size(png), 1000u);
+  const QImage image(QString::fromStdString(png.string()));
+  ASSERT_FALSE(image.isNull());
+  int not_white = 0;  // the whole figure drawn: axes, labels, lines
+  int black = 0;      // the truth
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c = image.pixelColor(x, y);
+      if (c != QColor(Qt::white)) ++not_white;
+      if (c == QColor(Qt::black)) ++black;
+    }
+  }
+  EXPECT_GT(not_white, image.width() * image.height() / 50);
+  EXPECT_GT(black, 100);
+
+  const fs::path svg = out / "top_view.svg";
+  ASSERT_TRUE(window.exportFigure(QString::fromStdString(svg.string())));
+  std::ifstream svg_in(svg);
+  const std::string svg_text((std::istreambuf_iterator<char>(svg_in)), {});
+  EXPECT_NE(svg_text.find("<svg"), std::string::npos);
+
+  const fs::path csv = out / "results.csv";
+  ASSERT_TRUE(window.exportTableCsv(QString::fromStdString(csv.string())));
+  std::ifstream csv_in(csv);
+  const std::string csv_text((std::istreambuf_iterator<char>(csv_in)), {});
+  EXPECT_EQ(csv_text, resultsCsv(window.run()->metrics));
+
+  EXPECT_FALSE(window.exportTableCsv(QString::fromStdString((out / "no" / "x.csv").string())));
+  EXPECT_FALSE(window.lastError().isEmpty());
+  EXPECT_NE(window.run(), nullptr);  // a failed export keeps the run
+}
+
+TEST_F(GuiPlotWindow, ADamagedRunShowsAnErrorAndTheWindowLivesOn) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  window.show();
+  settle();
+  EXPECT_FALSE(window.selectRun("sub/bad"));
+  EXPECT_EQ(window.run(), nullptr);
+  EXPECT_NE(window.lastError().toStdString().find("truth.tum"), std::string::npos)
+      << window.lastError().toStdString();
+  EXPECT_EQ(window.figureTabs()->count(), 0);
+  EXPECT_EQ(window.errorTable()->rowCount(), 0);
+  EXPECT_FALSE(window.exportFigure(
+      QString::fromStdString((test::freshDir("window_bad_out") / "x.png").string())));
+  EXPECT_FALSE(window.selectRun("no/such/run"));
+  settle();
+  EXPECT_TRUE(window.isVisible());
+  ASSERT_TRUE(window.selectRun("computed"));
+  EXPECT_TRUE(window.lastError().isEmpty());
+  EXPECT_EQ(window.figureTabs()->count(), 4);
+}
+
+}  // namespace
+}  // namespace nadir::gui
