@@ -57,10 +57,15 @@ inline eval::PoseTrajectory estimateTrajectory() {
   return estimates;
 }
 
-// A fresh, empty directory under the test's temporary directory.
+// A fresh, empty directory under the test's temporary directory, named after the
+// running test too: ctest runs the tests of one binary as parallel processes.
 inline std::filesystem::path freshDir(const std::string& name) {
+  std::string test_name;
+  if (const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    test_name.append(info->test_suite_name()).append("_").append(info->name()).append("_");
+  }
   const std::filesystem::path dir =
-      std::filesystem::path(::testing::TempDir()) / ("nadir_gui_" + name);
+      std::filesystem::path(::testing::TempDir()) / ("nadir_gui_" + test_name + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
