@@ -338,8 +338,8 @@ void PlotWindow::showRun() {
     const QString name = QString::fromStdString(figure.name);
     tabs_->addTab(interactiveFigure(std::move(figure)), name);
   }
-  // The table shows resultsCsv's text, so it holds the numbers of metrics.json
-  // (and of an export) exactly.
+  // The table holds resultsCsv's text, so the numbers of metrics.json (and of an
+  // export) exactly.
   std::istringstream csv(resultsCsv(run_->metrics));
   std::string line;
   std::getline(csv, line);  // the header: the columns below say it with units
@@ -351,8 +351,16 @@ void PlotWindow::showRun() {
     const int row = table_->rowCount();
     table_->insertRow(row);
     for (int column = 0; column < 6 && column < static_cast<int>(fields.size()); ++column) {
-      auto* cell = new QTableWidgetItem(QString::fromStdString(fields[column]));
-      if (column > 0) cell->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+      const QString exact = QString::fromStdString(fields[column]);
+      auto* cell = new QTableWidgetItem(exact);
+      if (column > 0) {
+        // Shown to a millimetre, a thousandth of a degree or percent; the exact
+        // value of metrics.json stays in the cell's data and tooltip.
+        if (!exact.isEmpty()) cell->setText(QString::number(exact.toDouble(), 'f', 3));
+        cell->setData(Qt::UserRole, exact);
+        cell->setToolTip(exact);
+        cell->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+      }
       table_->setItem(row, column, cell);
     }
   }
