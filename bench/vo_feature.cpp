@@ -3,9 +3,10 @@
 // run` with images) and RUN_DIR/scenario.yaml (the feature VO's parameters,
 // changed with --set), feeds every message through the same VoFeatureNode as
 // nadir run and the live node, and prints frames/s with the time of each stage
-// and the accuracy against the recorded truth. The local BA runs as the
-// scenario says (vo_feature.vo.background_ba: true, as live, by default; false
-// as in nadir run, whose figures it then reproduces exactly). The estimates and the truth go
+// and the accuracy against the recorded truth. The local BA runs as the run's
+// scenario.yaml says: on the tracking thread, as nadir run ran it (the metrics
+// then equal the run's to the last digit); --set vo_feature.vo.background_ba=true
+// runs it in its own thread, as live. The estimates and the truth go
 // to OUT/run.lcmlog with metrics.json, as `nadir run` writes them.
 //
 //   nadir run thesis-oscillating --set vehicle.altitude_agl_m=300

@@ -21,15 +21,6 @@
 #include <utility>
 
 namespace nadir::gui {
-namespace {
-
-// Enough points for a 1200 px wide chart; more only slow the drawing down.
-constexpr std::size_t kMaxPointsPerSeries = 4000;
-// A line is broken where samples are further apart than this (a gap in the
-// estimates), so that no pose is drawn where there was none.
-constexpr double kMaxGap_s = 1.0;
-
-const QColor kTruthColor(Qt::black);
 
 QColor sourceColor(const RunData& run, const std::string& name) {
   // Known sources keep their colour across runs; others take the rest in order.
@@ -46,6 +37,16 @@ QColor sourceColor(const RunData& run, const std::string& name) {
   }
   return kOthers[index % std::size(kOthers)];
 }
+
+namespace {
+
+// Enough points for a 1200 px wide chart; more only slow the drawing down.
+constexpr std::size_t kMaxPointsPerSeries = 4000;
+// A line is broken where samples are further apart than this (a gap in the
+// estimates), so that no pose is drawn where there was none.
+constexpr double kMaxGap_s = 1.0;
+
+const QColor kTruthColor(Qt::black);
 
 struct Range {
   double min = std::numeric_limits<double>::infinity();

@@ -5,6 +5,7 @@
 // Time axes show seconds since the truth's first pose.
 
 #include <QChart>
+#include <QColor>
 
 #include <memory>
 #include <string>
@@ -15,6 +16,9 @@
 class QWidget;
 
 namespace nadir::gui {
+
+// The colour of an estimate source in every chart (and in nadir-viewer).
+QColor sourceColor(const RunData& run, const std::string& name);
 
 // Charts shown together, stacked top to bottom.
 struct Figure {

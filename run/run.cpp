@@ -50,6 +50,10 @@ RunResult runScenario(const RunOptions& options,
   scenario::ScenarioParams scenario = scenario::loadScenario(options.scenario, options.overrides);
   // Everything stays in this process: the bus is in-process whatever the file says.
   scenario.bus.url = "memq://";
+  // Byte-identical runs: no wall-clock times, the feature VO's local BA at fixed
+  // key-frames. Set here so that scenario.yaml says what ran.
+  scenario.vo_feature.wall_clock_timing = false;
+  scenario.vo_feature.vo.background_ba = false;
 
   RunResult result;
   result.out_dir = options.out_dir.empty() ? defaultOutDir(options.scenario) : options.out_dir;
@@ -98,11 +102,7 @@ RunResult runScenario(const RunOptions& options,
   const std::vector<Eigen::Vector2d> targets_ne_m = scenario::knownTargets(scenario, frame);
   std::optional<vo::VoFeatureNode> vo_feature_node;
   if (scenario.vo_feature.enabled) {
-    vo::VoFeatureNodeParams params = scenario.vo_feature;
-    // Byte-identical runs: no wall-clock times, the local BA at fixed key-frames.
-    params.wall_clock_timing = false;
-    params.vo.background_ba = false;
-    vo_feature_node.emplace(*bus, params);
+    vo_feature_node.emplace(*bus, scenario.vo_feature);
   }
   if (scenario.ppa.enabled) {
     ppa_node.emplace(*bus, scenario.ppa, targets_ne_m);
