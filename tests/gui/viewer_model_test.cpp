@@ -1,0 +1,86 @@
+// nadir-viewer's model without a display: interpolation of a trajectory at a
+// playback time, the polylines drawn up to it, and the orbit camera's geometry.
+#include "gui/viewer_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "gui_test_util.h"
+
+namespace nadir::gui {
+namespace {
+
+PoseSeries line(const std::vector<double>& stamps) {
+  PoseSeries s;
+  for (double t : stamps) {
+    const Eigen::Vector3d p = test::truthPosition(t);
+    s.t_s.push_back(t);
+    s.x_m.push_back(p.x());
+    s.y_m.push_back(p.y());
+    s.z_m.push_back(p.z());
+  }
+  return s;
+}
+
+TEST(GuiViewerModel, PositionIsTheTruthInterpolated) {
+  const RunData run = loadRun(test::writeTumRun("model").string());
+  for (double t : {100.0, 100.05, 103.37, 109.99, 110.0}) {
+    const auto p = positionAt(run.truth, t);
+    ASSERT_TRUE(p) << t;
+    EXPECT_LT((*p - test::truthPosition(t)).norm(), 1e-9) << t;
+  }
+  EXPECT_FALSE(positionAt(run.truth, 99.99));
+  EXPECT_FALSE(positionAt(run.truth, 110.01));
+  EXPECT_DOUBLE_EQ(playbackDuration({run}), 10.0);
+}
+
+TEST(GuiViewerModel, NoPositionAcrossAGapOrAMissingPose) {
+  PoseSeries s = line({0.0, 0.5, 3.0, 3.5, 4.0});
+  s.x_m[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(positionAt(s, 0.25));
+  EXPECT_FALSE(positionAt(s, 2.0));
+  EXPECT_FALSE(positionAt(s, 3.75));
+}
+
+TEST(GuiViewerModel, TrackGrowsToTheTimeAndBreaksAtGaps) {
+  PoseSeries s = line({0.0, 0.5, 1.0, 3.0, 3.5, 4.0, 4.5});
+  s.y_m[5] = std::numeric_limits<double>::quiet_NaN();
+  const auto lines = trackUpTo(s, 3.25);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].size(), 3u);
+  ASSERT_EQ(lines[1].size(), 2u);
+  EXPECT_LT((lines[1].back() - test::truthPosition(3.25)).norm(), 1e-9);
+  const auto all = trackUpTo(s, 10.0);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[2].size(), 1u);
+  EXPECT_TRUE(trackUpTo(s, -1.0).empty());
+}
+
+TEST(GuiViewerModel, OrbitCameraLooksAtItsTarget) {
+  OrbitCamera camera;
+  camera.fit(Eigen::Vector3d(-100, -50, -120), Eigen::Vector3d(300, 250, -80));
+  const Eigen::Vector3d target(100, 100, -100);
+  EXPECT_LT((camera.target - target).norm(), 1e-9);
+  const auto centre = projectToPixel(camera, 640, 480, target);
+  ASSERT_TRUE(centre);
+  EXPECT_NEAR(centre->x(), 319.5, 1e-6);
+  EXPECT_NEAR(centre->y(), 239.5, 1e-6);
+  // Looking north: a point east of the target is right of the centre, one further
+  // north is above it (further away, so higher in the picture).
+  EXPECT_GT(projectToPixel(camera, 640, 480, target + Eigen::Vector3d(0, 10, 0))->x(), 320.0);
+  EXPECT_LT(projectToPixel(camera, 640, 480, target + Eigen::Vector3d(10, 0, 0))->y(), 239.0);
+  // Behind the camera: nothing.
+  const Eigen::Vector3d behind = camera.worldFromCamera() * Eigen::Vector3d(0, 0, -5);
+  EXPECT_FALSE(projectToPixel(camera, 640, 480, behind));
+  for (int i = 0; i < 100; ++i) camera.rotate(0, 50);
+  EXPECT_LT(camera.elevation_rad, 1.56);
+  EXPECT_TRUE(camera.worldFromCamera().linear().allFinite());
+  const double d = camera.distance_m;
+  camera.zoom(0.5);
+  EXPECT_DOUBLE_EQ(camera.distance_m, d * 0.5);
+}
+
+}  // namespace
+}  // namespace nadir::gui

@@ -1,0 +1,244 @@
+// nadir-viewer's window on a real run (made by `nadir run`, see CMakeLists.txt) on a
+// display with OpenGL 4.5 core: seeking, the time readout, the vehicle marker
+// against the truth, playback, and a rendered frame whose red ribbon lies where
+// the projection of the truth says.
+#include "gui/viewer_window.h"
+
+#include <QApplication>
+#include <QElapsedTimer>
+#include <QImage>
+#include <QMouseEvent>
+#include <QWheelEvent>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "gui/run_data.h"
+#include "gui/trajectory_view.h"
+#include "gui_test_util.h"
+
+namespace nadir::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+
+class GuiViewerWindow : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (QApplication::instance() != nullptr) return;
+    setViewerSurfaceFormat();
+    static int argc = 1;
+    static char name[] = "gui_viewer_window_test";
+    static char* argv[] = {name, nullptr};
+    // Never destroyed: Qt must outlive every test, and ends with the process.
+    new QApplication(argc, argv);
+  }
+
+  static std::string runDir() { return NADIR_VIEWER_RUN_DIR; }
+
+  static std::unique_ptr<ViewerWindow> open(const std::vector<std::string>& dirs) {
+    std::vector<RunData> runs;
+    for (const std::string& dir : dirs) runs.push_back(loadRun(dir));
+    auto window = std::make_unique<ViewerWindow>(
+        std::move(runs), terrainOfScenario((fs::path(dirs.front()) / "scenario.yaml").string()));
+    window->show();
+    window->view().setFixedSize(kWidth, kHeight);
+    settle();
+    return window;
+  }
+
+  static void settle() {
+    for (int i = 0; i < 5; ++i) QApplication::processEvents();
+  }
+};
+
+// The truth at t (s since its start), interpolated here without the viewer's code.
+Eigen::Vector3d truthAt(const RunData& run, double t) {
+  const PoseSeries& s = run.truth;
+  const double stamp = run.t0_s + t;
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    if (s.t_s[i] >= stamp) {
+      const double a = (stamp - s.t_s[i - 1]) / (s.t_s[i] - s.t_s[i - 1]);
+      return Eigen::Vector3d(s.x_m[i - 1] + a * (s.x_m[i] - s.x_m[i - 1]),
+                             s.y_m[i - 1] + a * (s.y_m[i] - s.y_m[i - 1]),
+                             s.z_m[i - 1] + a * (s.z_m[i] - s.z_m[i - 1]));
+    }
+  }
+  return Eigen::Vector3d(s.x_m.back(), s.y_m.back(), s.z_m.back());
+}
+
+bool isRed(QRgb c) { return qRed(c) > 200 && qGreen(c) < 60 && qBlue(c) < 60; }
+bool isYellow(QRgb c) { return qRed(c) > 200 && qGreen(c) > 200 && qBlue(c) < 60; }
+
+// True if a pixel matching within radius px of (u, v) exists.
+template <class Match>
+bool near(const QImage& image, const Eigen::Vector2d& uv, int radius, Match match) {
+  const int u0 = static_cast<int>(std::lround(uv.x()));
+  const int v0 = static_cast<int>(std::lround(uv.y()));
+  for (int v = v0 - radius; v <= v0 + radius; ++v) {
+    for (int u = u0 - radius; u <= u0 + radius; ++u) {
+      if (image.valid(u, v) && match(image.pixel(u, v))) return true;
+    }
+  }
+  return false;
+}
+
+TEST_F(GuiViewerWindow, SeekShowsTheTimeAndTheVehicleAtTheTruth) {
+  const auto window = open({runDir()});
+  const RunData& run = window->runs().front();
+  EXPECT_NEAR(window->duration(), run.truth.t_s.back() - run.t0_s, 1e-9);
+  for (double t : {0.0, 1.2345, 4.321, 7.77}) {
+    window->seek(t);
+    EXPECT_DOUBLE_EQ(window->time(), t);
+    EXPECT_EQ(window->timeText(), QString::asprintf("%.2f s / %.2f s", t, window->duration()));
+    const auto vehicle = window->view().vehiclePosition();
+    ASSERT_TRUE(vehicle);
+    EXPECT_LT((*vehicle - truthAt(run, t)).norm(), 1e-6) << t;
+  }
+  window->seek(1e9);
+  EXPECT_DOUBLE_EQ(window->time(), window->duration());
+  window->seek(-3.0);
+  EXPECT_DOUBLE_EQ(window->time(), 0.0);
+}
+
+TEST_F(GuiViewerWindow, FrameShowsTerrainAndTheRibbonWhereTheTruthProjects) {
+  const auto window = open({runDir()});
+  TrajectoryView& view = window->view();
+  const RunData& run = window->runs().front();
+  const double now = 6.0;
+  window->seek(now);
+  const QImage image = view.grabFramebuffer();
+  ASSERT_EQ(image.width(), kWidth);
+  ASSERT_EQ(image.height(), kHeight);
+  EXPECT_TRUE(view.terrainError().empty()) << view.terrainError();
+  image.save(
+      QString::fromStdString((fs::path(::testing::TempDir()) / "nadir_viewer_frame.png").string()));
+
+  // Not blank: the terrain's imagery gives many colours, not the clear colour alone.
+  std::set<QRgb> colours;
+  for (int v = 0; v < kHeight; v += 4) {
+    for (int u = 0; u < kWidth; u += 4) colours.insert(image.pixel(u, v));
+  }
+  EXPECT_GT(colours.size(), 200u);
+
+  const OrbitCamera camera = view.frameCamera();
+  int checked = 0;
+  for (double t = 0.0; t < now - 0.5; t += 0.25) {
+    const auto uv = projectToPixel(camera, kWidth, kHeight, truthAt(run, t));
+    ASSERT_TRUE(uv) << t;
+    if (!image.valid(static_cast<int>(uv->x()), static_cast<int>(uv->y()))) continue;
+    ++checked;
+    EXPECT_TRUE(near(image, *uv, 2, isRed)) << "t " << t << " at " << uv->transpose();
+  }
+  EXPECT_GT(checked, 10);
+  // Drawn only up to the playback time.
+  for (double t = now + 1.0; t <= window->duration(); t += 0.5) {
+    const auto uv = projectToPixel(camera, kWidth, kHeight, truthAt(run, t));
+    ASSERT_TRUE(uv);
+    EXPECT_FALSE(near(image, *uv, 1, isRed)) << "t " << t;
+  }
+  // The vehicle marker is centred on the truth now.
+  const auto vehicle_uv = projectToPixel(camera, kWidth, kHeight, truthAt(run, now));
+  ASSERT_TRUE(vehicle_uv);
+  EXPECT_TRUE(near(image, *vehicle_uv, 0, isYellow));
+}
+
+TEST_F(GuiViewerWindow, FollowKeepsTheVehicleInTheCentre) {
+  const auto window = open({runDir()});
+  TrajectoryView& view = window->view();
+  view.setFollow(true);
+  for (double t : {2.0, 8.0}) {
+    window->seek(t);
+    const auto vehicle = view.vehiclePosition();
+    ASSERT_TRUE(vehicle);
+    const auto uv = projectToPixel(view.frameCamera(), kWidth, kHeight, *vehicle);
+    ASSERT_TRUE(uv);
+    EXPECT_NEAR(uv->x(), (kWidth - 1) / 2.0, 1e-6);
+    EXPECT_NEAR(uv->y(), (kHeight - 1) / 2.0, 1e-6);
+    const QImage image = view.grabFramebuffer();
+    EXPECT_TRUE(near(image, *uv, 0, isYellow));
+  }
+}
+
+TEST_F(GuiViewerWindow, MouseRotatesPansAndZooms) {
+  const auto window = open({runDir()});
+  TrajectoryView& view = window->view();
+  const OrbitCamera before = view.camera();
+  const auto drag = [&](Qt::MouseButton button, QPointF from, QPointF to) {
+    QMouseEvent press(QEvent::MouseButtonPress, from, view.mapToGlobal(from), button, button,
+                      Qt::NoModifier);
+    QApplication::sendEvent(&view, &press);
+    QMouseEvent move(QEvent::MouseMove, to, view.mapToGlobal(to), Qt::NoButton, button,
+                     Qt::NoModifier);
+    QApplication::sendEvent(&view, &move);
+  };
+  drag(Qt::LeftButton, {100, 100}, {140, 120});
+  EXPECT_NE(view.camera().azimuth_rad, before.azimuth_rad);
+  EXPECT_GT(view.camera().elevation_rad, before.elevation_rad);
+  EXPECT_EQ(view.camera().target, before.target);
+  drag(Qt::RightButton, {100, 100}, {150, 100});
+  EXPECT_GT((view.camera().target - before.target).norm(), 0.1);
+  const QPointF centre(kWidth / 2.0, kHeight / 2.0);
+  QWheelEvent wheel(centre, view.mapToGlobal(centre), {}, {0, 120}, Qt::NoButton, Qt::NoModifier,
+                    Qt::NoScrollPhase, false);
+  QApplication::sendEvent(&view, &wheel);
+  EXPECT_LT(view.camera().distance_m, before.distance_m);
+}
+
+TEST_F(GuiViewerWindow, SeveralRunsPlayTogether) {
+  // A run whose truth lasts 10 s (the synthetic TUM run) and the real run twice.
+  const fs::path tum = test::writeTumRun("several");
+  fs::copy_file(fs::path(runDir()) / "scenario.yaml", tum / "scenario.yaml");
+  const auto window = open({runDir(), tum.string(), runDir()});
+  ASSERT_EQ(window->runs().size(), 3u);
+  const double expected =
+      std::max(window->runs()[0].truth.t_s.back() - window->runs()[0].t0_s, 10.0);
+  EXPECT_DOUBLE_EQ(window->duration(), expected);
+
+  window->setSpeed(100.0);
+  EXPECT_DOUBLE_EQ(window->speed(), 20.0);
+  window->setSpeed(0.09);
+  EXPECT_DOUBLE_EQ(window->speed(), 0.1);
+  window->setSpeed(20.0);
+  window->seek(0.0);
+  window->setPlaying(true);
+  QElapsedTimer clock;
+  clock.start();
+  while (clock.elapsed() < 200) QApplication::processEvents();
+  window->setPlaying(false);
+  const double played = window->time();
+  const double wall = static_cast<double>(clock.elapsed()) / 1000.0;
+  EXPECT_GT(played, 0.0);
+  EXPECT_LE(played, 20.0 * wall + 1e-9);
+  settle();
+  EXPECT_DOUBLE_EQ(window->time(), played);
+  // Playing to the end stops there.
+  window->seek(window->duration() - 0.05);
+  window->setPlaying(true);
+  clock.restart();
+  while (window->playing() && clock.elapsed() < 2000) QApplication::processEvents();
+  EXPECT_FALSE(window->playing());
+  EXPECT_DOUBLE_EQ(window->time(), window->duration());
+
+  // Every run's truth is drawn: the TUM run's line at t = 5 s (in a darker red).
+  window->seek(9.0);
+  const QImage image = window->view().grabFramebuffer();
+  const auto uv = projectToPixel(window->view().frameCamera(), kWidth, kHeight,
+                                 test::truthPosition(test::kT0 + 5.0));
+  ASSERT_TRUE(uv);
+  const QColor second = truthColor(1);
+  EXPECT_TRUE(near(image, *uv, 2, [&](QRgb c) { return QColor(c) == second; })) << uv->transpose();
+}
+
+}  // namespace
+}  // namespace nadir::gui
