@@ -334,77 +334,73 @@ std::map<std::string, std::string> defaultSourceChannels() {
   return {{"POSE_PPA", "ppa"}, {"POSE_VO_FEATURE", "vo_feature"}, {"POSE_VO_DIRECT", "vo_direct"}};
 }
 
-LogTrajectories readRunLog(const std::string& log_path,
-                           const std::map<std::string, std::string>& source_channels) {
-  constexpr char kTruthChannel[] = "POSE_TRUTH";
-  LogTrajectories out;
-  std::map<std::string, std::size_t> undecodable;  // channel -> count
-  std::size_t events = 0;
-  try {
-    core::LcmLogReader reader(log_path);
-    while (const std::optional<core::LogEvent> event = reader.next()) {
-      ++events;
-      if (event->channel == kTruthChannel) {
-        nadir::pose_t message;
-        if (!core::decodeMessage(event->data.data(), event->data.size(), message)) {
-          ++undecodable[event->channel];
-          continue;
-        }
-        StampedPose pose;
-        pose.t_s = static_cast<double>(message.utime) / 1e6;
-        pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
-        try {
-          pose.q = core::quaternionFromWire(message.orientation);
-        } catch (const std::exception&) {
-          ++undecodable[event->channel];
-          continue;
-        }
-        if (!pose.p_m.allFinite()) {
-          ++undecodable[event->channel];
-          continue;
-        }
-        out.truth.push_back(pose);
-        continue;
-      }
-      const auto source = source_channels.find(event->channel);
-      if (source == source_channels.end()) continue;
-      nadir::vo_estimate_t message;
-      if (!core::decodeMessage(event->data.data(), event->data.size(), message)) {
-        ++undecodable[event->channel];
-        continue;
-      }
-      SourceEstimate estimate;
-      estimate.t_s = static_cast<double>(message.utime) / 1e6;
-      estimate.status = message.status;
-      if (estimate.status == SourceEstimate::kTracking) {
-        estimate.p_m =
-            Eigen::Vector3d(message.pose.pos[0], message.pose.pos[1], message.pose.pos[2]);
-        try {
-          estimate.q = core::quaternionFromWire(message.pose.orientation);
-        } catch (const std::exception&) {
-          ++undecodable[event->channel];
-          continue;
-        }
-        if (!estimate.p_m.allFinite()) {
-          ++undecodable[event->channel];
-          continue;
-        }
-      }
-      out.sources[source->second].push_back(estimate);
+TrajectoryCollector::TrajectoryCollector(std::map<std::string, std::string> source_channels)
+    : source_channels_(std::move(source_channels)) {}
+
+bool TrajectoryCollector::add(const std::string& channel, const void* data, std::size_t size) {
+  if (channel == kTruthChannel) {
+    nadir::pose_t message;
+    if (!core::decodeMessage(data, size, message)) {
+      ++undecodable_[channel];
+      return true;
     }
-    out.damage = reader.damageReport();
-  } catch (const core::LogError& error) {
-    throw EvalError(error.what());
+    StampedPose pose;
+    pose.t_s = static_cast<double>(message.utime) / 1e6;
+    pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
+    try {
+      pose.q = core::quaternionFromWire(message.orientation);
+    } catch (const std::exception&) {
+      ++undecodable_[channel];
+      return true;
+    }
+    if (!pose.p_m.allFinite()) {
+      ++undecodable_[channel];
+      return true;
+    }
+    truth_.push_back(pose);
+    return true;
   }
-  for (const auto& [channel, count] : undecodable) {
-    appendNote(out.damage, std::to_string(count) + " undecodable or invalid message" +
-                               (count == 1 ? "" : "s") + " on " + channel);
+  const auto source = source_channels_.find(channel);
+  if (source == source_channels_.end()) return false;
+  nadir::vo_estimate_t message;
+  if (!core::decodeMessage(data, size, message)) {
+    ++undecodable_[channel];
+    return true;
   }
-  if (events == 0) throw EvalError(log_path + ": the log is empty (no events)");
-  if (out.truth.empty()) {
-    throw EvalError(log_path + ": no truth: no valid pose_t on " + kTruthChannel + " among " +
-                    std::to_string(events) + " events");
+  SourceEstimate estimate;
+  estimate.t_s = static_cast<double>(message.utime) / 1e6;
+  estimate.status = message.status;
+  if (estimate.status == SourceEstimate::kTracking) {
+    estimate.p_m = Eigen::Vector3d(message.pose.pos[0], message.pose.pos[1], message.pose.pos[2]);
+    try {
+      estimate.q = core::quaternionFromWire(message.pose.orientation);
+    } catch (const std::exception&) {
+      ++undecodable_[channel];
+      return true;
+    }
+    if (!estimate.p_m.allFinite()) {
+      ++undecodable_[channel];
+      return true;
+    }
   }
+  sources_[source->second].push_back(estimate);
+  return true;
+}
+
+std::string TrajectoryCollector::undecodableReport() const {
+  std::string report;
+  for (const auto& [channel, count] : undecodable_) {
+    appendNote(report, std::to_string(count) + " undecodable or invalid message" +
+                           (count == 1 ? "" : "s") + " on " + channel);
+  }
+  return report;
+}
+
+LogTrajectories TrajectoryCollector::trajectories() const {
+  LogTrajectories out;
+  out.truth = truth_;
+  out.sources = sources_;
+  out.damage = undecodableReport();
   std::stable_sort(out.truth.begin(), out.truth.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.t_s < b.t_s; });
   const auto duplicate =
@@ -416,6 +412,33 @@ LogTrajectories readRunLog(const std::string& log_path,
         estimates.begin(), estimates.end(),
         [](const SourceEstimate& a, const SourceEstimate& b) { return a.t_s < b.t_s; });
   }
+  return out;
+}
+
+LogTrajectories readRunLog(const std::string& log_path,
+                           const std::map<std::string, std::string>& source_channels) {
+  TrajectoryCollector collector(source_channels);
+  std::size_t events = 0;
+  std::string reader_damage;
+  try {
+    core::LcmLogReader reader(log_path);
+    while (const std::optional<core::LogEvent> event = reader.next()) {
+      ++events;
+      collector.add(event->channel, event->data.data(), event->data.size());
+    }
+    reader_damage = reader.damageReport();
+  } catch (const core::LogError& error) {
+    throw EvalError(error.what());
+  }
+  if (events == 0) throw EvalError(log_path + ": the log is empty (no events)");
+  if (collector.truthPoses() == 0) {
+    throw EvalError(log_path + ": no truth: no valid pose_t on " + kTruthChannel + " among " +
+                    std::to_string(events) + " events");
+  }
+  LogTrajectories out = collector.trajectories();
+  std::string damage = std::move(reader_damage);
+  if (!out.damage.empty()) appendNote(damage, out.damage);
+  out.damage = std::move(damage);
   return out;
 }
 

@@ -118,6 +118,34 @@ struct LogTrajectories {
   std::map<std::string, std::vector<SourceEstimate>> sources;  // sources seen in the log
   std::string damage;  // the reader's damage report and undecodable messages; empty if clean
 };
+// The channel of the truth, pose_t.
+inline constexpr char kTruthChannel[] = "POSE_TRUTH";
+
+// Gathers the truth (pose_t on kTruthChannel) and the estimates (vo_estimate_t on
+// source_channels) one message at a time, stamped with the messages' utime: from
+// the events of a log (readRunLog) or from a live bus (nadir-viewer --live).
+class TrajectoryCollector {
+ public:
+  explicit TrajectoryCollector(
+      std::map<std::string, std::string> source_channels = defaultSourceChannels());
+  // Takes one message; false if its channel is neither the truth's nor a source's.
+  // A message on those channels that does not decode, or holds a non-finite
+  // position or a quaternion that is not a rotation, is counted and left out.
+  bool add(const std::string& channel, const void* data, std::size_t size);
+  std::size_t truthPoses() const { return truth_.size(); }
+  // What was gathered so far, sorted as LogTrajectories says; `damage` counts the
+  // messages left out, per channel.
+  LogTrajectories trajectories() const;
+
+ private:
+  std::string undecodableReport() const;
+
+  std::map<std::string, std::string> source_channels_;
+  PoseTrajectory truth_;
+  std::map<std::string, std::vector<SourceEstimate>> sources_;
+  std::map<std::string, std::size_t> undecodable_;  // channel -> count
+};
+
 // Reads pose_t on POSE_TRUTH and vo_estimate_t on source_channels, stamped with
 // the messages' utime. A damaged log gives what could be read, and says what was
 // wrong in `damage`. Throws EvalError naming the log if it cannot be opened, is

@@ -178,6 +178,23 @@ RunData loadRun(const std::string& dir) {
   return run;
 }
 
+RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,
+                     const eval::EvalOptions& options) {
+  if (recorded.truth.empty()) throw RunDataError(name + ": no truth pose");
+  RunData run;
+  run.dir = name;
+  run.damage = recorded.damage;
+  run.options = options;
+  run.t0_s = recorded.truth.front().t_s;
+  for (const eval::StampedPose& pose : recorded.truth) {
+    appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
+  }
+  for (const auto& [source, estimates] : recorded.sources) {
+    run.sources[source] = sourceSeries(recorded.truth, estimates, options.truth_max_gap_s);
+  }
+  return run;
+}
+
 std::string resultsCsv(const eval::RunMetrics& metrics) {
   std::string out = "source,position_rmse_m,rotation_rmse_deg,tracked_pct,ape_rmse_m,rpe_rmse_m\n";
   for (const auto& [name, m] : metrics.sources) {

@@ -73,6 +73,11 @@ std::vector<std::string> findRuns(const std::string& root);
 // does not parse, a metrics.json of another schema) or a run with no poses.
 RunData loadRun(const std::string& dir);
 
+// A run of poses already read (a live bus): the series of loadRun, named `name`
+// (RunData::dir), with the metrics left empty. Throws RunDataError without truth.
+RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,
+                     const eval::EvalOptions& options = {});
+
 // The error table, one row per source, as CSV with a header line:
 //   source,position_rmse_m,rotation_rmse_deg,tracked_pct,ape_rmse_m,rpe_rmse_m
 // Numbers in the shortest text that reads back to the same double (the values of

@@ -22,7 +22,7 @@
 namespace nadir::gui {
 namespace {
 
-constexpr double kTruthWidthPx = 3.0;
+constexpr double kTruthWidthPx = 4.0;
 constexpr double kSourceWidthPx = 2.0;
 constexpr double kMarkerHalfPx = 6.0;
 constexpr double kNearM = 0.5;
@@ -180,6 +180,11 @@ struct TrajectoryView::Gl {
 TrajectoryView::TrajectoryView(const std::vector<RunData>& runs,
                                std::optional<ViewerTerrain> terrain, QWidget* parent)
     : QOpenGLWidget(parent), runs_(runs), terrain_(std::move(terrain)) {
+  fitToRuns();
+  setMinimumSize(320, 240);
+}
+
+bool TrajectoryView::fitToRuns() {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const RunData& run : runs_) {
@@ -190,8 +195,35 @@ TrajectoryView::TrajectoryView(const std::vector<RunData>& runs,
       hi = hi.cwiseMax(p);
     }
   }
-  if (lo.allFinite()) camera_.fit(lo, hi);
-  setMinimumSize(320, 240);
+  if (!lo.allFinite()) return false;
+  camera_.fit(lo, hi);
+  update();
+  return true;
+}
+
+void TrajectoryView::setTerrain(std::optional<ViewerTerrain> terrain) {
+  terrain_ = std::move(terrain);
+  terrain_error_.clear();
+  if (gl_) {
+    makeCurrent();
+    createTerrainRenderer();
+    doneCurrent();
+  }
+  update();
+}
+
+void TrajectoryView::createTerrainRenderer() {
+  gl_->terrain.reset();
+  if (!terrain_) return;
+  // Without the terrain the trajectories are still worth showing.
+  try {
+    gl_->terrain = std::make_unique<render::TerrainRenderer>(terrain_->tiles, terrain_->renderer);
+    gl_->terrain->setTargets(terrain_->targets);
+  } catch (const std::exception& e) {
+    gl_->terrain.reset();
+    terrain_error_ = e.what();
+    std::fprintf(stderr, "nadir-viewer: no terrain: %s\n", e.what());
+  }
 }
 
 TrajectoryView::~TrajectoryView() { releaseGl(); }
@@ -238,17 +270,7 @@ void TrajectoryView::initializeGL() {
   gl_ = std::make_unique<Gl>();
   // The context may go before the widget (reparenting): free the GL objects then.
   connect(context(), &QOpenGLContext::aboutToBeDestroyed, this, [this] { releaseGl(); });
-  if (terrain_) {
-    // Without the terrain the trajectories are still worth showing.
-    try {
-      gl_->terrain = std::make_unique<render::TerrainRenderer>(terrain_->tiles, terrain_->renderer);
-      gl_->terrain->setTargets(terrain_->targets);
-    } catch (const std::exception& e) {
-      gl_->terrain.reset();
-      terrain_error_ = e.what();
-      std::fprintf(stderr, "nadir-viewer: no terrain: %s\n", e.what());
-    }
-  }
+  createTerrainRenderer();
   gl_->program = render::linkProgram("viewer overlay", kVertexShader, kFragmentShader);
   glCreateVertexArrays(1, &gl_->vertex_array);
   glCreateBuffers(1, &gl_->vertex_buffer);
@@ -286,20 +308,21 @@ void TrajectoryView::paintGL() {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   }
 
-  // Estimates first, the truths over them, the vehicle on top: trajectories are
+  // The wider truths first, the estimates over them (an estimate close to the
+  // truth stays visible along its middle), the vehicle on top: trajectories are
   // never hidden by the terrain.
   Overlay overlay(camera, w, h);
+  for (std::size_t r = 0; r < runs_.size(); ++r) {
+    for (const auto& line : trackUpTo(runs_[r].truth, runs_[r].t0_s + time_s_)) {
+      overlay.polyline(line, truthColor(r), kTruthWidthPx);
+    }
+  }
   for (const RunData& run : runs_) {
     for (const auto& [name, source] : run.sources) {
       const QColor color = sourceColor(run, name);
       for (const auto& line : trackUpTo(source.pose, run.t0_s + time_s_)) {
         overlay.polyline(line, color, kSourceWidthPx);
       }
-    }
-  }
-  for (std::size_t r = 0; r < runs_.size(); ++r) {
-    for (const auto& line : trackUpTo(runs_[r].truth, runs_[r].t0_s + time_s_)) {
-      overlay.polyline(line, truthColor(r), kTruthWidthPx);
     }
   }
   if (const auto vehicle = vehiclePosition()) {
@@ -335,12 +358,14 @@ void TrajectoryView::mouseMoveEvent(QMouseEvent* event) {
   } else {
     return;
   }
+  camera_moved_ = true;
   update();
 }
 
 void TrajectoryView::wheelEvent(QWheelEvent* event) {
   // One wheel notch (120) zooms by 15 %.
   camera_.zoom(std::pow(0.85, event->angleDelta().y() / 120.0));
+  camera_moved_ = true;
   update();
 }
 

@@ -50,7 +50,7 @@ QColor truthColor(std::size_t run_index);
 
 class TrajectoryView : public QOpenGLWidget {
  public:
-  // runs must outlive the view; the camera starts fitted to every truth.
+  // runs must outlive the view (it may grow); the camera starts fitted to every truth.
   TrajectoryView(const std::vector<RunData>& runs, std::optional<ViewerTerrain> terrain,
                  QWidget* parent = nullptr);
   ~TrajectoryView() override;
@@ -61,6 +61,13 @@ class TrajectoryView : public QOpenGLWidget {
   void setTime(double t_s);
   double time() const { return time_s_; }
   void setFollow(bool follow);
+  // Fits the camera to every truth; false (camera kept) while there is none.
+  bool fitToRuns();
+  // Replaces the terrain drawn (nothing: plain ground).
+  void setTerrain(std::optional<ViewerTerrain> terrain);
+  bool hasTerrain() const { return terrain_.has_value(); }
+  // True once a drag or the wheel has moved the camera.
+  bool cameraMovedByUser() const { return camera_moved_; }
   bool follow() const { return follow_; }
   OrbitCamera& camera() { return camera_; }
   // The camera the next frame is drawn from (the vehicle as target in follow mode).
@@ -83,6 +90,7 @@ class TrajectoryView : public QOpenGLWidget {
  private:
   struct Gl;
   void releaseGl();
+  void createTerrainRenderer();
 
   const std::vector<RunData>& runs_;
   std::optional<ViewerTerrain> terrain_;
@@ -90,6 +98,7 @@ class TrajectoryView : public QOpenGLWidget {
   OrbitCamera camera_;
   double time_s_ = 0.0;
   bool follow_ = false;
+  bool camera_moved_ = false;
   QPoint last_mouse_;
   std::string terrain_error_;
 };

@@ -2,32 +2,81 @@
 
 #include <QCheckBox>
 #include <QComboBox>
+#include <QFileDialog>
 #include <QHBoxLayout>
+#include <QKeySequence>
 #include <QLabel>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPixmap>
 #include <QPushButton>
+#include <QResizeEvent>
 #include <QSlider>
+#include <QSplitter>
 #include <QStatusBar>
 #include <QVBoxLayout>
 #include <QWidget>
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <utility>
 
+#include "gui/live_feed.h"
 #include "gui/plots.h"
 
 namespace nadir::gui {
 namespace {
 
+namespace fs = std::filesystem;
+
 // Slider steps per second of playback.
 constexpr double kSliderStepsPerS = 100.0;
 // Timer period while playing; the time advances by the wall clock, not by ticks.
 constexpr int kTickMs = 33;
+// How often live mode takes the bus's messages.
+constexpr int kLivePollMs = 50;
 
 QString swatch(const QColor& color, const QString& text) {
   return QStringLiteral("<span style=\"color:%1\">&#9632;</span> %2").arg(color.name(), text);
 }
+
+// A QLabel that shows its image scaled to its size, keeping the aspect ratio.
+class ImageLabel : public QLabel {
+ public:
+  explicit ImageLabel(QWidget* parent) : QLabel(parent) {
+    setAlignment(Qt::AlignCenter);
+    setMinimumSize(320, 240);
+    setStyleSheet(QStringLiteral("background-color: #202020; color: #c0c0c0;"));
+    setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Ignored);
+  }
+  void setImage(const QImage& image) {
+    image_ = image;
+    rescale();
+  }
+
+ protected:
+  void resizeEvent(QResizeEvent* event) override {
+    QLabel::resizeEvent(event);
+    rescale();
+  }
+
+ private:
+  void rescale() {
+    if (image_.isNull()) {
+      setPixmap(QPixmap());
+      return;
+    }
+    setPixmap(
+        QPixmap::fromImage(image_.scaled(size(), Qt::KeepAspectRatio, Qt::SmoothTransformation)));
+  }
+  QImage image_;
+};
+
+std::string runName(const RunData& run) { return fs::path(run.dir).filename().string(); }
+
+bool isLogPath(const std::string& path) { return fs::path(path).extension() == ".lcmlog"; }
 
 }  // namespace
 
@@ -44,12 +93,27 @@ QString viewerLegend(const std::vector<RunData>& runs) {
     for (const auto& [name, source] : runs[r].sources) {
       items << swatch(sourceColor(runs[r], name), QString::fromStdString(name));
     }
-    const QString dir =
-        QString::fromStdString(std::filesystem::path(runs[r].dir).filename().string());
+    const QString dir = QString::fromStdString(runName(runs[r]));
     lines << QStringLiteral("<b>%1</b>: %2")
                  .arg(dir.toHtmlEscaped(), items.join(QStringLiteral("&nbsp;&nbsp;")));
   }
   return lines.join(QStringLiteral("<br>"));
+}
+
+std::string scenarioOfRun(const std::string& run_path) {
+  std::error_code error;
+  const fs::path path(run_path);
+  const fs::path folder = fs::is_directory(path, error) ? path : path.parent_path();
+  const fs::path scenario = folder / "scenario.yaml";
+  return fs::is_regular_file(scenario, error) ? scenario.string() : std::string();
+}
+
+QImage toQImage(const CameraFrame& frame) {
+  const cv::Mat& m = frame.pixels;
+  if (m.empty()) return {};
+  const QImage::Format format =
+      m.channels() == 1 ? QImage::Format_Grayscale8 : QImage::Format_RGB888;
+  return QImage(m.data, m.cols, m.rows, static_cast<qsizetype>(m.step), format).copy();
 }
 
 ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrain> terrain,
@@ -57,44 +121,175 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
     : QMainWindow(parent), runs_(std::move(runs)), duration_s_(playbackDuration(runs_)) {
   auto* central = new QWidget(this);
   auto* layout = new QVBoxLayout(central);
-  auto* legend = new QLabel(viewerLegend(runs_), central);
-  legend->setTextFormat(Qt::RichText);
-  layout->addWidget(legend);
-  view_ = new TrajectoryView(runs_, std::move(terrain), central);
-  layout->addWidget(view_, 1);
+  legend_ = new QLabel(central);
+  legend_->setTextFormat(Qt::RichText);
+  layout->addWidget(legend_);
+
+  auto* splitter = new QSplitter(Qt::Horizontal, central);
+  view_ = new TrajectoryView(runs_, std::move(terrain), splitter);
+  auto* camera_panel = new QWidget(splitter);
+  auto* camera_layout = new QVBoxLayout(camera_panel);
+  camera_layout->setContentsMargins(0, 0, 0, 0);
+  camera_view_ = new ImageLabel(camera_panel);
+  camera_caption_ = new QLabel(camera_panel);
+  camera_caption_->setWordWrap(true);
+  camera_layout->addWidget(camera_view_, 1);
+  camera_layout->addWidget(camera_caption_);
+  splitter->addWidget(view_);
+  splitter->addWidget(camera_panel);
+  splitter->setStretchFactor(0, 3);
+  splitter->setStretchFactor(1, 2);
+  layout->addWidget(splitter, 1);
 
   auto* controls = new QHBoxLayout;
   play_ = new QPushButton(QStringLiteral("Play"), central);
   play_->setShortcut(Qt::Key_Space);
   slider_ = new QSlider(Qt::Horizontal, central);
-  slider_->setRange(0, static_cast<int>(std::ceil(duration_s_ * kSliderStepsPerS)));
   time_label_ = new QLabel(central);
   time_label_->setMinimumWidth(
       time_label_->fontMetrics().horizontalAdvance("0000.00 s / 0000.00 s"));
   speed_ = new QComboBox(central);
   for (double s : speeds()) speed_->addItem(QStringLiteral("%1x").arg(s), s);
   follow_ = new QCheckBox(QStringLiteral("Follow vehicle"), central);
+  live_ = new QCheckBox(QStringLiteral("Live"), central);
+  live_->setToolTip(QStringLiteral("stay at the newest message"));
+  live_->setVisible(false);
   controls->addWidget(play_);
   controls->addWidget(slider_, 1);
   controls->addWidget(time_label_);
   controls->addWidget(speed_);
   controls->addWidget(follow_);
+  controls->addWidget(live_);
   layout->addLayout(controls);
   setCentralWidget(central);
   setSpeed(1.0);
 
+  QMenu* file = menuBar()->addMenu(QStringLiteral("&File"));
+  file->addAction(QStringLiteral("Open run folder..."), QKeySequence::Open,
+                  [this] { openDialog(false); });
+  file->addAction(QStringLiteral("Open LCM log..."), [this] { openDialog(true); });
+  file->addSeparator();
+  file->addAction(QStringLiteral("Quit"), QKeySequence::Quit, [this] { close(); });
+
   connect(play_, &QPushButton::clicked, this, [this] { setPlaying(!playing()); });
   connect(slider_, &QSlider::valueChanged, this, [this](int value) {
     // Only the user's moves seek; showTime() moves it too.
-    if (!showing_time_) seek(value / kSliderStepsPerS);
+    if (showing_time_) return;
+    live_->setChecked(false);
+    seek(value / kSliderStepsPerS);
   });
   connect(follow_, &QCheckBox::toggled, this, [this](bool on) { view_->setFollow(on); });
+  connect(live_, &QCheckBox::toggled, this, [this](bool on) {
+    if (on) {
+      setPlaying(false);
+      seek(duration_s_);
+    }
+  });
   connect(&timer_, &QTimer::timeout, this, [this] { tick(); });
   timer_.setInterval(kTickMs);
+  connect(&live_timer_, &QTimer::timeout, this, [this] { pollLive(); });
+  live_timer_.setInterval(kLivePollMs);
   statusBar()->showMessage(QStringLiteral("left drag: rotate, right drag: pan, wheel: zoom"));
   setWindowTitle(QStringLiteral("nadir-viewer"));
-  resize(1200, 800);
-  showTime();
+  resize(1400, 800);
+
+  if (!runs_.empty() && isLogPath(runs_.front().poses_from)) {
+    try {
+      log_frames_ = std::make_unique<LogCameraFrames>(runs_.front().poses_from);
+    } catch (const std::exception& e) {
+      camera_note_ = e.what();
+    }
+  }
+  runsChanged();
+}
+
+ViewerWindow::~ViewerWindow() = default;
+
+void ViewerWindow::attachLive(LiveFeed& feed, const QString& name) {
+  feed_ = &feed;
+  live_name_ = name;
+  log_frames_.reset();
+  live_->setVisible(true);
+  live_->setChecked(true);
+  live_timer_.start();
+  pollLive();
+}
+
+bool ViewerWindow::followingLive() const { return feed_ != nullptr && live_->isChecked(); }
+
+void ViewerWindow::pollLive() {
+  if (feed_ == nullptr) return;
+  try {
+    feed_->poll();
+  } catch (const std::exception& e) {
+    live_timer_.stop();
+    statusBar()->showMessage(QStringLiteral("live: the bus failed: %1").arg(e.what()));
+    return;
+  }
+  if (feed_->version() == live_version_) return;
+  live_version_ = feed_->version();
+  std::optional<RunData> run = feed_->run(live_name_.toStdString());
+  if (run) {
+    const bool first = runs_.empty() || runs_.front().dir != run->dir;
+    if (first) {
+      runs_.insert(runs_.begin(), std::move(*run));
+    } else {
+      runs_.front() = std::move(*run);
+    }
+    // The whole flight stays in view as it grows, until the user moves the camera.
+    if (!view_->cameraMovedByUser()) view_->fitToRuns();
+  }
+  runsChanged();
+  if (live_->isChecked()) seek(duration_s_);
+}
+
+void ViewerWindow::openRun(const std::string& path) {
+  RunData run = loadRun(path);
+  if (!run.damage.empty()) statusBar()->showMessage(QString::fromStdString(run.damage));
+  runs_.push_back(std::move(run));
+  if (runs_.size() == 1 && isLogPath(runs_.front().poses_from) && feed_ == nullptr) {
+    try {
+      log_frames_ = std::make_unique<LogCameraFrames>(runs_.front().poses_from);
+    } catch (const std::exception& e) {
+      camera_note_ = e.what();
+    }
+  }
+  if (!view_->hasTerrain()) {
+    const std::string scenario = scenarioOfRun(path);
+    if (!scenario.empty()) {
+      try {
+        view_->setTerrain(terrainOfScenario(scenario));
+      } catch (const std::exception& e) {
+        statusBar()->showMessage(QStringLiteral("no terrain: %1").arg(e.what()));
+      }
+    }
+  }
+  if (runs_.size() == 1) view_->fitToRuns();
+  runsChanged();
+}
+
+void ViewerWindow::openDialog(bool log_file) {
+  const QString path =
+      log_file ? QFileDialog::getOpenFileName(this, QStringLiteral("Open an LCM log"), QString(),
+                                              QStringLiteral("LCM logs (*.lcmlog);;All files (*)"))
+               : QFileDialog::getExistingDirectory(this, QStringLiteral("Open a run folder"));
+  if (path.isEmpty()) return;
+  try {
+    openRun(path.toStdString());
+  } catch (const std::exception& e) {
+    QMessageBox::warning(this, QStringLiteral("nadir-viewer"), QString::fromUtf8(e.what()));
+  }
+}
+
+void ViewerWindow::runsChanged() {
+  duration_s_ = playbackDuration(runs_);
+  legend_->setText(runs_.empty() ? QStringLiteral("waiting for the truth on %1")
+                                       .arg(QString::fromUtf8(eval::kTruthChannel))
+                                 : viewerLegend(runs_));
+  showing_time_ = true;
+  slider_->setRange(0, static_cast<int>(std::ceil(duration_s_ * kSliderStepsPerS)));
+  showing_time_ = false;
+  seek(time());
 }
 
 void ViewerWindow::seek(double t_s) {
@@ -109,6 +304,7 @@ QString ViewerWindow::timeText() const {
 void ViewerWindow::setPlaying(bool playing) {
   if (playing == this->playing()) return;
   if (playing) {
+    live_->setChecked(false);
     // Play from the start again once at the end.
     if (time() >= duration_s_) seek(0.0);
     clock_.start();
@@ -140,6 +336,41 @@ void ViewerWindow::showTime() {
   slider_->setValue(static_cast<int>(std::lround(time() * kSliderStepsPerS)));
   showing_time_ = false;
   time_label_->setText(timeText());
+  showCamera();
+}
+
+QString ViewerWindow::cameraCaption() const { return camera_caption_->text(); }
+
+void ViewerWindow::showCamera() {
+  CameraFrames* frames = feed_ != nullptr ? feed_->frames() : log_frames_.get();
+  QString caption;
+  std::optional<CameraFrame> frame;
+  if (frames == nullptr) {
+    caption = camera_note_.empty() ? QStringLiteral("no camera images")
+                                   : QString::fromStdString(camera_note_);
+  } else if (frames->count() == 0) {
+    caption = QStringLiteral("no images on %1").arg(QString::fromStdString(frames->describe()));
+  } else if (!runs_.empty()) {
+    try {
+      frame = frames->frameAt(runs_.front().t0_s + time());
+    } catch (const std::exception& e) {
+      caption = QString::fromUtf8(e.what());
+    }
+    if (frame) {
+      caption = QStringLiteral("%1, image %2 at %3 s")
+                    .arg(QString::fromStdString(frames->describe()))
+                    .arg(frame->number)
+                    .arg(frame->t_s - runs_.front().t0_s, 0, 'f', 2);
+      if (!frame->error.empty())
+        caption += QStringLiteral(": ") + QString::fromStdString(frame->error);
+    } else if (caption.isEmpty()) {
+      caption = QStringLiteral("%1: no image yet").arg(QString::fromStdString(frames->describe()));
+    }
+  }
+  camera_image_ = frame ? toQImage(*frame) : QImage();
+  static_cast<ImageLabel*>(camera_view_)->setImage(camera_image_);
+  if (camera_image_.isNull()) camera_view_->setText(QStringLiteral("no image"));
+  camera_caption_->setText(caption);
 }
 
 }  // namespace nadir::gui

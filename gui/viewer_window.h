@@ -1,16 +1,22 @@
 #pragma once
 // nadir-viewer's window: the 3D view of one or more runs over the first run's
-// terrain, and playback synchronised over every run and trajectory (play/pause,
-// seek slider, time readout, speed 0.1x to 20x, follow the vehicle).
+// terrain, the first run's camera image beside it, and playback synchronised over
+// every run and trajectory (play/pause, seek slider, time readout, speed 0.1x to
+// 20x, follow the vehicle). Runs come from run folders and LCM logs (File menu or
+// the constructor) or, in live mode, from a LiveFeed on a bus.
 
 #include <QElapsedTimer>
+#include <QImage>
 #include <QMainWindow>
 #include <QString>
 #include <QTimer>
 
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "gui/camera_frames.h"
 #include "gui/run_data.h"
 #include "gui/trajectory_view.h"
 
@@ -22,10 +28,26 @@ class QSlider;
 
 namespace nadir::gui {
 
+class LiveFeed;
+
 class ViewerWindow : public QMainWindow {
  public:
+  // The first run's camera images are read from its log when it has one.
   ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrain> terrain,
                QWidget* parent = nullptr);
+  ~ViewerWindow() override;
+
+  // Live mode: the run is taken from feed (which must outlive the window) as it
+  // grows, and is always the first run. With "Live" on, playback stays at the
+  // newest truth.
+  void attachLive(LiveFeed& feed, const QString& name);
+  // Takes what the feed holds now (the live timer calls it).
+  void pollLive();
+  bool followingLive() const;
+
+  // Opens a run folder or an LCM log and adds it to the runs; the terrain is
+  // taken from its scenario.yaml if the window has none yet. Throws RunDataError.
+  void openRun(const std::string& path);
 
   TrajectoryView& view() { return *view_; }
   const std::vector<RunData>& runs() const { return runs_; }
@@ -42,24 +64,48 @@ class ViewerWindow : public QMainWindow {
   double speed() const;
   static const std::vector<double>& speeds();
 
+  // The camera image shown (full resolution; null when none) and its caption.
+  const QImage& cameraImage() const { return camera_image_; }
+  QString cameraCaption() const;
+
  private:
   void tick();
   void showTime();
+  void showCamera();
+  void runsChanged();
+  void openDialog(bool log_file);
 
   std::vector<RunData> runs_;
   double duration_s_ = 0.0;
   TrajectoryView* view_ = nullptr;
+  QLabel* legend_ = nullptr;
+  QLabel* camera_view_ = nullptr;
+  QLabel* camera_caption_ = nullptr;
   QPushButton* play_ = nullptr;
   QSlider* slider_ = nullptr;
   QLabel* time_label_ = nullptr;
   QComboBox* speed_ = nullptr;
   QCheckBox* follow_ = nullptr;
+  QCheckBox* live_ = nullptr;
   QTimer timer_;
+  QTimer live_timer_;
   QElapsedTimer clock_;
   bool showing_time_ = false;
+  std::unique_ptr<CameraFrames> log_frames_;  // the first run's, from its log
+  LiveFeed* feed_ = nullptr;
+  QString live_name_;
+  std::uint64_t live_version_ = 0;
+  QImage camera_image_;
+  std::string camera_note_;  // why no image is shown
 };
 
 // The HTML legend: each run's truth and sources in their colours.
 QString viewerLegend(const std::vector<RunData>& runs);
+
+// scenario.yaml of a run folder, or beside an LCM log; empty if there is none.
+std::string scenarioOfRun(const std::string& run_path);
+
+// A camera frame as a QImage (Format_Grayscale8 or Format_RGB888; a deep copy).
+QImage toQImage(const CameraFrame& frame);
 
 }  // namespace nadir::gui

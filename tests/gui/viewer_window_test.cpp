@@ -13,16 +13,23 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "core/bus.h"
+#include "core/lcm_log.h"
+#include "gui/live_feed.h"
 #include "gui/run_data.h"
 #include "gui/trajectory_view.h"
 #include "gui_test_util.h"
+#include "nadir/image_t.hpp"
+#include "nadir/pose_t.hpp"
 
 namespace nadir::gui {
 namespace {
@@ -238,6 +245,140 @@ TEST_F(GuiViewerWindow, SeveralRunsPlayTogether) {
   ASSERT_TRUE(uv);
   const QColor second = truthColor(1);
   EXPECT_TRUE(near(image, *uv, 2, [&](QRgb c) { return QColor(c) == second; })) << uv->transpose();
+}
+
+// The camera image beside the view is the run's newest image at the playback
+// time, found here by reading the log without the viewer's code.
+TEST_F(GuiViewerWindow, CameraPanelShowsTheLogImageOfTheTime) {
+  const auto window = open({runDir()});
+  const RunData& run = window->runs().front();
+  for (double t : {0.5, 3.3, 7.01}) {
+    window->seek(t);
+    nadir::image_t expected;
+    bool found = false;
+    int number = -1;
+    core::LcmLogReader reader((fs::path(runDir()) / "run.lcmlog").string());
+    int images = 0;
+    while (const auto event = reader.next()) {
+      if (event->channel != "CAMERA_DOWN") continue;
+      nadir::image_t message;
+      ASSERT_TRUE(core::decodeMessage(event->data.data(), event->data.size(), message));
+      if (static_cast<double>(message.utime) / 1e6 <= run.t0_s + t) {
+        expected = message;
+        found = true;
+        number = images;
+      }
+      ++images;
+    }
+    ASSERT_TRUE(found) << t;
+    const QImage& shown = window->cameraImage();
+    ASSERT_EQ(shown.width(), expected.width);
+    ASSERT_EQ(shown.height(), expected.height);
+    ASSERT_EQ(expected.pixelformat, nadir::image_t::PIXEL_FORMAT_GRAY);
+    int differing = 0;
+    for (int v = 0; v < expected.height; v += 7) {
+      for (int u = 0; u < expected.width; u += 7) {
+        const int value = expected.data[static_cast<std::size_t>(v * expected.row_stride + u)];
+        if (qGray(shown.pixel(u, v)) != value) ++differing;
+      }
+    }
+    EXPECT_EQ(differing, 0) << t;
+    EXPECT_TRUE(window->cameraCaption().contains(QStringLiteral("image %1 at").arg(number)))
+        << window->cameraCaption().toStdString();
+  }
+}
+
+// Live mode: the run grows as messages come on the bus, playback stays at the
+// newest truth until the user plays, and the newest image is shown.
+TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
+  const std::unique_ptr<core::Bus> bus = core::openBus("memq://");
+  LiveFeed feed(*bus);
+  ViewerWindow window({}, std::nullopt);
+  window.show();
+  window.attachLive(feed, QStringLiteral("live"));
+  EXPECT_TRUE(window.runs().empty());
+  EXPECT_DOUBLE_EQ(window.duration(), 0.0);
+
+  const auto publish = [&](int k_begin, int k_end) {
+    for (int k = k_begin; k < k_end; ++k) {
+      const double t = test::truthStamp(k);
+      nadir::pose_t pose{};
+      pose.utime = static_cast<std::int64_t>(std::llround(t * 1e6));
+      const Eigen::Vector3d p = test::truthPosition(t);
+      for (int i = 0; i < 3; ++i) pose.pos[i] = p[i];
+      pose.orientation[0] = 1.0;
+      core::publish(*bus, "POSE_TRUTH", pose);
+      if (k % 5 == 0) {
+        nadir::image_t image{};
+        image.utime = pose.utime;
+        image.width = 16;
+        image.height = 12;
+        image.row_stride = 16;
+        image.pixelformat = nadir::image_t::PIXEL_FORMAT_GRAY;
+        image.data.assign(16 * 12, static_cast<std::uint8_t>(k));
+        image.size = 16 * 12;
+        core::publish(*bus, "CAMERA_DOWN", image);
+      }
+    }
+  };
+  publish(0, 31);  // 3 s of truth
+  window.pollLive();
+  ASSERT_EQ(window.runs().size(), 1u);
+  EXPECT_EQ(window.runs().front().truth.size(), 31u);
+  EXPECT_NEAR(window.duration(), 3.0, 1e-6);
+  EXPECT_TRUE(window.followingLive());
+  EXPECT_NEAR(window.time(), 3.0, 1e-6);
+  EXPECT_EQ(window.timeText(), QStringLiteral("3.00 s / 3.00 s"));
+  ASSERT_FALSE(window.cameraImage().isNull());
+  EXPECT_EQ(window.cameraImage().width(), 16);
+  EXPECT_EQ(qGray(window.cameraImage().pixel(5, 5)), 30);
+  const auto vehicle = window.view().vehiclePosition();
+  ASSERT_TRUE(vehicle);
+  EXPECT_LT((*vehicle - test::truthPosition(test::truthStamp(30))).norm(), 1e-6);
+
+  // Later messages extend it and the time follows.
+  publish(31, 81);
+  window.pollLive();
+  EXPECT_EQ(window.runs().front().truth.size(), 81u);
+  EXPECT_NEAR(window.time(), 8.0, 1e-6);
+  EXPECT_EQ(qGray(window.cameraImage().pixel(5, 5)), 80);
+
+  // Seeking back to look at the past leaves live: new messages do not move it.
+  window.setPlaying(true);
+  window.setPlaying(false);
+  EXPECT_FALSE(window.followingLive());
+  window.seek(2.0);
+  publish(81, 101);
+  window.pollLive();
+  EXPECT_NEAR(window.duration(), 10.0, 1e-6);
+  EXPECT_DOUBLE_EQ(window.time(), 2.0);
+  EXPECT_EQ(qGray(window.cameraImage().pixel(5, 5)), 20);
+
+  // A flight that starts again (the truth's time goes back) replaces the old one.
+  window.setPlaying(false);
+  publish(0, 11);
+  window.pollLive();
+  ASSERT_EQ(window.runs().size(), 1u);
+  EXPECT_EQ(window.runs().front().truth.size(), 11u);
+  EXPECT_NEAR(window.duration(), 1.0, 1e-6);
+}
+
+// Runs opened from the window are added to the others; the first brings its
+// scenario's terrain; a folder that is not a run is refused with nothing lost.
+TEST_F(GuiViewerWindow, OpenRunAddsARunAndItsTerrain) {
+  ViewerWindow window({}, std::nullopt);
+  window.show();
+  EXPECT_FALSE(window.view().hasTerrain());
+  window.openRun(runDir());
+  ASSERT_EQ(window.runs().size(), 1u);
+  EXPECT_TRUE(window.view().hasTerrain());
+  EXPECT_GT(window.duration(), 5.0);
+  EXPECT_TRUE(window.view().vehiclePosition().has_value());
+  const fs::path empty = test::freshDir("not_a_run");
+  EXPECT_THROW(window.openRun(empty.string()), RunDataError);
+  EXPECT_EQ(window.runs().size(), 1u);
+  window.openRun((fs::path(runDir()) / "run.lcmlog").string());
+  EXPECT_EQ(window.runs().size(), 2u);
 }
 
 }  // namespace
