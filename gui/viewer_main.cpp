@@ -42,7 +42,8 @@ int main(int argc, char** argv) {
   app.add_option("--recv-buf-size", recv_buf_bytes,
                  "UDP receive buffer for --live on udpm://, bytes (0: the system's)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--camera-channel", camera_channel, "image_t channel shown beside the 3D view");
+  app.add_option("--camera-channel", camera_channel,
+                 "image_t channel shown beside the 3D view (live and logs)");
   double at_s = 0.0;
   double wait_s = 0.5;
   std::string screenshot;
@@ -93,6 +94,7 @@ int main(int argc, char** argv) {
   nadir::gui::setViewerSurfaceFormat();
   QApplication qapp(argc, argv);
   nadir::gui::ViewerWindow window(std::move(runs), std::move(terrain));
+  if (camera_channel != nadir::gui::kDefaultCameraChannel) window.setCameraChannel(camera_channel);
   if (feed) window.attachLive(*feed, QStringLiteral("live"));
   window.show();
   if (!live) window.seek(at_s);

@@ -130,6 +130,9 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   auto* camera_panel = new QWidget(splitter);
   auto* camera_layout = new QVBoxLayout(camera_panel);
   camera_layout->setContentsMargins(0, 0, 0, 0);
+  camera_run_ = new QComboBox(camera_panel);
+  camera_run_->setToolTip(QStringLiteral("whose camera to show"));
+  camera_layout->addWidget(camera_run_);
   camera_view_ = new ImageLabel(camera_panel);
   camera_caption_ = new QLabel(camera_panel);
   camera_caption_->setWordWrap(true);
@@ -185,6 +188,9 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
       seek(duration_s_);
     }
   });
+  connect(camera_run_, &QComboBox::currentIndexChanged, this, [this] {
+    if (!showing_time_) showCamera();
+  });
   connect(&timer_, &QTimer::timeout, this, [this] { tick(); });
   timer_.setInterval(kTickMs);
   connect(&live_timer_, &QTimer::timeout, this, [this] { pollLive(); });
@@ -193,13 +199,6 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   setWindowTitle(QStringLiteral("nadir-viewer"));
   resize(1400, 800);
 
-  if (!runs_.empty() && isLogPath(runs_.front().poses_from)) {
-    try {
-      log_frames_ = std::make_unique<LogCameraFrames>(runs_.front().poses_from);
-    } catch (const std::exception& e) {
-      camera_note_ = e.what();
-    }
-  }
   runsChanged();
 }
 
@@ -208,7 +207,6 @@ ViewerWindow::~ViewerWindow() = default;
 void ViewerWindow::attachLive(LiveFeed& feed, const QString& name) {
   feed_ = &feed;
   live_name_ = name;
-  log_frames_.reset();
   live_->setVisible(true);
   live_->setChecked(true);
   live_timer_.start();
@@ -229,8 +227,8 @@ void ViewerWindow::pollLive() {
   if (feed_->version() == live_version_) return;
   live_version_ = feed_->version();
   std::optional<RunData> run = feed_->run(live_name_.toStdString());
+  const bool first = run && (runs_.empty() || runs_.front().dir != run->dir);
   if (run) {
-    const bool first = runs_.empty() || runs_.front().dir != run->dir;
     if (first) {
       runs_.insert(runs_.begin(), std::move(*run));
     } else {
@@ -240,6 +238,7 @@ void ViewerWindow::pollLive() {
     if (!view_->cameraMovedByUser()) view_->fitToRuns();
   }
   runsChanged();
+  if (first && run) showCameraOf(live_name_.toStdString());
   if (live_->isChecked()) seek(duration_s_);
 }
 
@@ -247,13 +246,6 @@ void ViewerWindow::openRun(const std::string& path) {
   RunData run = loadRun(path);
   if (!run.damage.empty()) statusBar()->showMessage(QString::fromStdString(run.damage));
   runs_.push_back(std::move(run));
-  if (runs_.size() == 1 && isLogPath(runs_.front().poses_from) && feed_ == nullptr) {
-    try {
-      log_frames_ = std::make_unique<LogCameraFrames>(runs_.front().poses_from);
-    } catch (const std::exception& e) {
-      camera_note_ = e.what();
-    }
-  }
   if (!view_->hasTerrain()) {
     const std::string scenario = scenarioOfRun(path);
     if (!scenario.empty()) {
@@ -288,6 +280,20 @@ void ViewerWindow::runsChanged() {
                                  : viewerLegend(runs_));
   showing_time_ = true;
   slider_->setRange(0, static_cast<int>(std::ceil(duration_s_ * kSliderStepsPerS)));
+  // The camera choice lists the runs by name, keeping the one chosen (the first
+  // run's by default).
+  QStringList names;
+  for (const RunData& run : runs_) names << QString::fromStdString(run.dir);
+  QStringList listed;
+  for (int i = 0; i < camera_run_->count(); ++i) listed << camera_run_->itemData(i).toString();
+  if (names != listed) {
+    const QString chosen = camera_run_->currentData().toString();
+    camera_run_->clear();
+    for (const RunData& run : runs_) {
+      camera_run_->addItem(QString::fromStdString(runName(run)), QString::fromStdString(run.dir));
+    }
+    camera_run_->setCurrentIndex(std::max(0, static_cast<int>(names.indexOf(chosen))));
+  }
   showing_time_ = false;
   seek(time());
 }
@@ -339,20 +345,63 @@ void ViewerWindow::showTime() {
   showCamera();
 }
 
+void ViewerWindow::showCameraOf(const std::string& run_dir) {
+  const int index = camera_run_->findData(QString::fromStdString(run_dir));
+  if (index >= 0) camera_run_->setCurrentIndex(index);
+}
+
+void ViewerWindow::setCameraChannel(const std::string& channel) {
+  camera_channel_ = channel;
+  log_frames_.clear();
+  showCamera();
+}
+
 QString ViewerWindow::cameraCaption() const { return camera_caption_->text(); }
 
+const RunData* ViewerWindow::cameraRun() const {
+  const std::string dir = camera_run_->currentData().toString().toStdString();
+  for (const RunData& run : runs_) {
+    if (run.dir == dir) return &run;
+  }
+  return nullptr;
+}
+
+CameraFrames* ViewerWindow::framesOf(const RunData& run, std::string& note) {
+  if (feed_ != nullptr && run.dir == live_name_.toStdString()) return feed_->frames();
+  if (!isLogPath(run.poses_from)) {
+    note = "no camera images: " + runName(run) + " has no log";
+    return nullptr;
+  }
+  auto found = log_frames_.find(run.poses_from);
+  if (found == log_frames_.end()) {
+    // Indexed when first shown: a log of images takes a moment to read.
+    std::unique_ptr<CameraFrames> frames;
+    try {
+      frames = std::make_unique<LogCameraFrames>(run.poses_from, camera_channel_);
+    } catch (const std::exception& e) {
+      note = e.what();
+    }
+    found = log_frames_.emplace(run.poses_from, std::move(frames)).first;
+  }
+  if (!found->second && note.empty()) note = run.poses_from + ": cannot be read";
+  return found->second.get();
+}
+
 void ViewerWindow::showCamera() {
-  CameraFrames* frames = feed_ != nullptr ? feed_->frames() : log_frames_.get();
+  const RunData* run = cameraRun();
+  std::string note;
+  CameraFrames* frames = run != nullptr ? framesOf(*run, note) : nullptr;
   QString caption;
   std::optional<CameraFrame> frame;
-  if (frames == nullptr) {
-    caption = camera_note_.empty() ? QStringLiteral("no camera images")
-                                   : QString::fromStdString(camera_note_);
+  if (run == nullptr) {
+    caption = QStringLiteral("no run");
+  } else if (frames == nullptr) {
+    caption = QString::fromStdString(note);
   } else if (frames->count() == 0) {
     caption = QStringLiteral("no images on %1").arg(QString::fromStdString(frames->describe()));
-  } else if (!runs_.empty()) {
+  } else {
     try {
-      frame = frames->frameAt(runs_.front().t0_s + time());
+      frame = frames->frameAt(run->t0_s + time());
     } catch (const std::exception& e) {
       caption = QString::fromUtf8(e.what());
     }
@@ -360,9 +409,10 @@ void ViewerWindow::showCamera() {
       caption = QStringLiteral("%1, image %2 at %3 s")
                     .arg(QString::fromStdString(frames->describe()))
                     .arg(frame->number)
-                    .arg(frame->t_s - runs_.front().t0_s, 0, 'f', 2);
-      if (!frame->error.empty())
+                    .arg(frame->t_s - run->t0_s, 0, 'f', 2);
+      if (!frame->error.empty()) {
         caption += QStringLiteral(": ") + QString::fromStdString(frame->error);
+      }
     } else if (caption.isEmpty()) {
       caption = QStringLiteral("%1: no image yet").arg(QString::fromStdString(frames->describe()));
     }

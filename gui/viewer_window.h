@@ -1,6 +1,6 @@
 #pragma once
 // nadir-viewer's window: the 3D view of one or more runs over the first run's
-// terrain, the first run's camera image beside it, and playback synchronised over
+// terrain, a chosen run's camera image beside it, and playback synchronised over
 // every run and trajectory (play/pause, seek slider, time readout, speed 0.1x to
 // 20x, follow the vehicle). Runs come from run folders and LCM logs (File menu or
 // the constructor) or, in live mode, from a LiveFeed on a bus.
@@ -11,6 +11,7 @@
 #include <QString>
 #include <QTimer>
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,7 +33,6 @@ class LiveFeed;
 
 class ViewerWindow : public QMainWindow {
  public:
-  // The first run's camera images are read from its log when it has one.
   ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrain> terrain,
                QWidget* parent = nullptr);
   ~ViewerWindow() override;
@@ -64,6 +64,10 @@ class ViewerWindow : public QMainWindow {
   double speed() const;
   static const std::vector<double>& speeds();
 
+  // Whose camera image is shown: the run whose dir is given (the first by default).
+  void showCameraOf(const std::string& run_dir);
+  // The image_t channel shown (CAMERA_DOWN by default).
+  void setCameraChannel(const std::string& channel);
   // The camera image shown (full resolution; null when none) and its caption.
   const QImage& cameraImage() const { return camera_image_; }
   QString cameraCaption() const;
@@ -74,11 +78,15 @@ class ViewerWindow : public QMainWindow {
   void showCamera();
   void runsChanged();
   void openDialog(bool log_file);
+  const RunData* cameraRun() const;
+  // The images of a run (live, or from its log); null with the reason in note.
+  CameraFrames* framesOf(const RunData& run, std::string& note);
 
   std::vector<RunData> runs_;
   double duration_s_ = 0.0;
   TrajectoryView* view_ = nullptr;
   QLabel* legend_ = nullptr;
+  QComboBox* camera_run_ = nullptr;
   QLabel* camera_view_ = nullptr;
   QLabel* camera_caption_ = nullptr;
   QPushButton* play_ = nullptr;
@@ -91,12 +99,13 @@ class ViewerWindow : public QMainWindow {
   QTimer live_timer_;
   QElapsedTimer clock_;
   bool showing_time_ = false;
-  std::unique_ptr<CameraFrames> log_frames_;  // the first run's, from its log
+  // Each run's images by its log's path, indexed when first shown; null if unreadable.
+  std::map<std::string, std::unique_ptr<CameraFrames>> log_frames_;
+  std::string camera_channel_ = kDefaultCameraChannel;
   LiveFeed* feed_ = nullptr;
   QString live_name_;
   std::uint64_t live_version_ = 0;
   QImage camera_image_;
-  std::string camera_note_;  // why no image is shown
 };
 
 // The HTML legend: each run's truth and sources in their colours.

@@ -288,6 +288,24 @@ TEST_F(GuiViewerWindow, CameraPanelShowsTheLogImageOfTheTime) {
   }
 }
 
+// The camera panel shows the chosen run's images: a run read from TUM files has
+// none, and says so.
+TEST_F(GuiViewerWindow, CameraPanelShowsTheChosenRun) {
+  const fs::path tum = test::writeTumRun("camera_choice");
+  const auto window = open({runDir(), tum.string()});
+  window->seek(2.0);
+  EXPECT_FALSE(window->cameraImage().isNull());
+  window->showCameraOf(tum.string());
+  EXPECT_TRUE(window->cameraImage().isNull());
+  EXPECT_TRUE(window->cameraCaption().contains(QStringLiteral("has no log")))
+      << window->cameraCaption().toStdString();
+  window->showCameraOf(runDir());
+  EXPECT_FALSE(window->cameraImage().isNull());
+  window->setCameraChannel("CAMERA_NONE");
+  EXPECT_TRUE(window->cameraImage().isNull());
+  EXPECT_EQ(window->cameraCaption(), QStringLiteral("no images on run.lcmlog CAMERA_NONE"));
+}
+
 // Live mode: the run grows as messages come on the bus, playback stays at the
 // newest truth until the user plays, and the newest image is shown.
 TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
