@@ -25,6 +25,8 @@ namespace {
 constexpr double kTruthWidthPx = 4.0;
 constexpr double kSourceWidthPx = 2.0;
 constexpr double kMarkerHalfPx = 6.0;
+constexpr double kEstimateHalfPx = 3.0;
+constexpr double kVehicleLengthPx = 30.0;
 constexpr double kNearM = 0.5;
 
 const char* kVertexShader = R"(#version 450 core
@@ -65,7 +67,28 @@ class Overlay {
          c + Eigen::Vector2d(half_px, half_px), c + Eigen::Vector2d(-half_px, half_px), color);
   }
 
+  // An arrowhead in the body's x-y plane at p_world, nose along body x, length_px
+  // long on screen; p_world lies inside it.
+  void vehicle(const Eigen::Vector3d& p_world, const Eigen::Quaterniond& q_world_body,
+               double length_px, const QColor& color) {
+    const Eigen::Vector3d p = camera_from_world_ * p_world;
+    if (p.z() <= kNearM) return;
+    const double length_m = length_px * p.z() / intrinsics_.fx;
+    const Eigen::Matrix3d R = q_world_body.toRotationMatrix();
+    const auto body = [&](double x, double y) {
+      return Eigen::Vector3d(p_world + R * Eigen::Vector3d(x * length_m, y * length_m, 0.0));
+    };
+    triangle(body(kNose, 0), body(kWing, -kSpan), body(kTail, 0), color);
+    triangle(body(kNose, 0), body(kTail, 0), body(kWing, kSpan), color);
+  }
+
   const std::vector<float>& vertices() const { return vertices_; }
+
+  // The vehicle's shape, in lengths from its position along body x and y.
+  static constexpr double kNose = 0.6;
+  static constexpr double kWing = -0.4;
+  static constexpr double kSpan = 0.45;
+  static constexpr double kTail = -0.2;
 
  private:
   void segment(const Eigen::Vector3d& a_world, const Eigen::Vector3d& b_world, const QColor& color,
@@ -87,6 +110,15 @@ class Overlay {
     // Half a width past each end closes the joints between segments.
     const Eigen::Vector2d e = along * (width_px / 2.0);
     quad(pa - e + n, pb + e + n, pb + e - n, pa - e - n, color);
+  }
+
+  void triangle(const Eigen::Vector3d& a_world, const Eigen::Vector3d& b_world,
+                const Eigen::Vector3d& c_world, const QColor& color) {
+    const Eigen::Vector3d a = camera_from_world_ * a_world;
+    const Eigen::Vector3d b = camera_from_world_ * b_world;
+    const Eigen::Vector3d c = camera_from_world_ * c_world;
+    if (a.z() <= kNearM || b.z() <= kNearM || c.z() <= kNearM) return;
+    for (const Eigen::Vector3d* q : {&a, &b, &c}) vertex(intrinsics_.project(*q), color);
   }
 
   void quad(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
@@ -325,9 +357,24 @@ void TrajectoryView::paintGL() {
       }
     }
   }
+  // Where each estimate is now, then the vehicle with its attitude.
+  for (const RunData& run : runs_) {
+    for (const auto& [name, source] : run.sources) {
+      if (const auto p = positionAt(source.pose, run.t0_s + time_s_)) {
+        overlay.square(*p, Qt::black, kEstimateHalfPx + 1.0);
+        overlay.square(*p, sourceColor(run, name), kEstimateHalfPx);
+      }
+    }
+  }
   if (const auto vehicle = vehiclePosition()) {
-    overlay.square(*vehicle, Qt::black, kMarkerHalfPx + 1.5);
-    overlay.square(*vehicle, Qt::yellow, kMarkerHalfPx);
+    const auto attitude = attitudeAt(runs_.front().truth, runs_.front().t0_s + time_s_);
+    if (attitude) {
+      overlay.vehicle(*vehicle, *attitude, kVehicleLengthPx + 6.0, Qt::black);
+      overlay.vehicle(*vehicle, *attitude, kVehicleLengthPx, Qt::yellow);
+    } else {
+      overlay.square(*vehicle, Qt::black, kMarkerHalfPx + 1.5);
+      overlay.square(*vehicle, Qt::yellow, kMarkerHalfPx);
+    }
   }
   const std::vector<float>& vertices = overlay.vertices();
   glDisable(GL_DEPTH_TEST);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/frames.h"
+
 namespace nadir::gui {
 namespace {
 
@@ -13,24 +15,50 @@ bool hasPose(const PoseSeries& s, std::size_t i) {
 
 Eigen::Vector3d at(const PoseSeries& s, std::size_t i) { return {s.x_m[i], s.y_m[i], s.z_m[i]}; }
 
-}  // namespace
+Eigen::Quaterniond attitudeOf(const PoseSeries& s, std::size_t i) {
+  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+  return core::quaternionFromRpy(
+      {s.roll_deg[i] * kRadPerDeg, s.pitch_deg[i] * kRadPerDeg, s.yaw_deg[i] * kRadPerDeg});
+}
 
-std::optional<Eigen::Vector3d> positionAt(const PoseSeries& series, double t_s, double max_gap_s) {
+// The samples around t_s and the fraction of the way from the first to the second
+// (the same sample twice at the series' last stamp), under positionAt's conditions.
+struct Bracket {
+  std::size_t i0 = 0;
+  std::size_t i1 = 0;
+  double a = 0.0;
+};
+
+std::optional<Bracket> bracket(const PoseSeries& series, double t_s, double max_gap_s) {
   const auto& t = series.t_s;
   if (t.empty() || t_s < t.front() || t_s > t.back()) return std::nullopt;
   const auto upper = std::upper_bound(t.begin(), t.end(), t_s);
   if (upper == t.end()) {
     const std::size_t last = t.size() - 1;
     if (!hasPose(series, last)) return std::nullopt;
-    return at(series, last);
+    return Bracket{last, last, 0.0};
   }
   const auto i1 = static_cast<std::size_t>(upper - t.begin());
   const std::size_t i0 = i1 - 1;
   if (!hasPose(series, i0) || !hasPose(series, i1) || t[i1] - t[i0] > max_gap_s) {
     return std::nullopt;
   }
-  const double a = (t_s - t[i0]) / (t[i1] - t[i0]);
-  return (1.0 - a) * at(series, i0) + a * at(series, i1);
+  return Bracket{i0, i1, (t_s - t[i0]) / (t[i1] - t[i0])};
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> positionAt(const PoseSeries& series, double t_s, double max_gap_s) {
+  const std::optional<Bracket> b = bracket(series, t_s, max_gap_s);
+  if (!b) return std::nullopt;
+  return (1.0 - b->a) * at(series, b->i0) + b->a * at(series, b->i1);
+}
+
+std::optional<Eigen::Quaterniond> attitudeAt(const PoseSeries& series, double t_s,
+                                             double max_gap_s) {
+  const std::optional<Bracket> b = bracket(series, t_s, max_gap_s);
+  if (!b) return std::nullopt;
+  return attitudeOf(series, b->i0).slerp(b->a, attitudeOf(series, b->i1));
 }
 
 std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const PoseSeries& series, double t_s,

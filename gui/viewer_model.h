@@ -24,6 +24,11 @@ inline constexpr double kViewerMaxGap_s = 1.0;
 std::optional<Eigen::Vector3d> positionAt(const PoseSeries& series, double t_s,
                                           double max_gap_s = kViewerMaxGap_s);
 
+// The series' attitude (body to world NED) at t_s, interpolated (slerp) between the
+// samples around it, under positionAt's conditions.
+std::optional<Eigen::Quaterniond> attitudeAt(const PoseSeries& series, double t_s,
+                                             double max_gap_s = kViewerMaxGap_s);
+
 // The series' polylines from its start up to t_s (absolute stamp), broken where a
 // sample has no pose or samples are more than max_gap_s apart. The last polyline
 // ends at positionAt(t_s) when that exists, so a line grows smoothly with time.

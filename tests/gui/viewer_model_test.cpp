@@ -6,7 +6,9 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
+#include "core/frames.h"
 #include "gui_test_util.h"
 
 namespace nadir::gui {
@@ -80,6 +82,23 @@ TEST(GuiViewerModel, OrbitCameraLooksAtItsTarget) {
   const double d = camera.distance_m;
   camera.zoom(0.5);
   EXPECT_DOUBLE_EQ(camera.distance_m, d * 0.5);
+}
+
+// The attitude halfway between yaw 170 deg and -170 deg is yaw 180 deg (the short
+// way round, not 0), at roll 10 deg throughout; none outside the span or across a gap.
+TEST(GuiViewerModel, AttitudeIsInterpolatedTheShortWayRound) {
+  PoseSeries s = line({0.0, 1.0, 5.0});
+  s.roll_deg = {10.0, 10.0, 10.0};
+  s.pitch_deg = {0.0, 0.0, 0.0};
+  s.yaw_deg = {170.0, -170.0, -170.0};
+  const auto q = attitudeAt(s, 0.5);
+  ASSERT_TRUE(q);
+  constexpr double kRad = std::numbers::pi / 180.0;
+  const Eigen::Quaterniond expected = core::quaternionFromRpy({10.0 * kRad, 0.0, 180.0 * kRad});
+  EXPECT_LT(q->angularDistance(expected), 1e-9);
+  EXPECT_FALSE(attitudeAt(s, -0.1));
+  EXPECT_FALSE(attitudeAt(s, 3.0));
+  ASSERT_TRUE(attitudeAt(s, 5.0));
 }
 
 }  // namespace

@@ -177,6 +177,29 @@ TEST_F(GuiViewerWindow, FollowKeepsTheVehicleInTheCentre) {
   }
 }
 
+// The vehicle is drawn pointing where the truth heads: yellow ahead of its
+// position on screen, not behind it.
+TEST_F(GuiViewerWindow, VehiclePointsAlongItsHeading) {
+  const auto window = open({runDir()});
+  TrajectoryView& view = window->view();
+  view.setFollow(true);
+  const RunData& run = window->runs().front();
+  for (double t : {2.0, 8.0}) {
+    window->seek(t);
+    const Eigen::Vector3d p = truthAt(run, t);
+    // Heading from the truth's track here, independent of its attitude samples.
+    const Eigen::Vector3d ahead = truthAt(run, t + 0.2) - p;
+    const auto uv = projectToPixel(view.frameCamera(), kWidth, kHeight, p);
+    const auto uv_ahead =
+        projectToPixel(view.frameCamera(), kWidth, kHeight, p + ahead.normalized());
+    ASSERT_TRUE(uv && uv_ahead);
+    const Eigen::Vector2d d = (*uv_ahead - *uv).normalized();
+    const QImage image = view.grabFramebuffer();
+    EXPECT_TRUE(near(image, *uv + 8.0 * d, 0, isYellow)) << t;
+    EXPECT_FALSE(near(image, *uv - 8.0 * d, 0, isYellow)) << t;
+  }
+}
+
 TEST_F(GuiViewerWindow, MouseRotatesPansAndZooms) {
   const auto window = open({runDir()});
   TrajectoryView& view = window->view();
