@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Renders the pictures in docs/images with `nadir snapshot`: what the 1280x960
+# Renders the pictures in docs/images: with `nadir snapshot`, what the 1280x960
 # downward camera sees at 10, 50 and 300 m above ground over the procedural
-# world and over Zion National Park (SRTM DEM, Landsat 8 imagery at 30 m).
+# world and over Zion National Park (SRTM DEM, Landsat 8 imagery at 30 m); with
+# nadir-viewer, the demo's run.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 nadir="$root/build/bin/nadir"
@@ -19,3 +20,9 @@ for agl in 10 50 300; do
     --out "$out/procedural_${agl}m.png"
   "$nadir" snapshot "${common[@]}" "${zion[@]}" --set agl_m=$agl --out "$out/zion_${agl}m.png"
 done
+
+# The trajectory viewer on the demo's run at 140 s (run `./nadir demo` first).
+if [[ -d "$root/out/demo" ]]; then
+  xvfb-run -a -s "-screen 0 1400x1000x24" "$root/build/bin/nadir-viewer" "$root/out/demo" \
+    --at 140 --screenshot "$out/nadir_viewer.png" >/dev/null
+fi
