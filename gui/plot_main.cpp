@@ -2,11 +2,11 @@
 // (default: out if it exists, else the current folder); --headless renders a
 // run's charts to PNG files and its error table to results.csv.
 //
-//   nadir-plot [DIR]
-//   nadir-plot --headless RUN_DIR --out DIR
+//   nadir-plot [DIR|LOG]
+//   nadir-plot --headless RUN_DIR|LOG --out DIR
 //
 // RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
-// DIR/<its path under RUN_DIR>.
+// DIR/<its path under RUN_DIR> (a loose log's without .lcmlog).
 
 #include <CLI/CLI.hpp>
 
@@ -67,9 +67,10 @@ int main(int argc, char** argv) {
   std::string run_dir;
   std::string out_dir;
   bool headless = false;
-  app.add_option("run_dir", run_dir,
-                 "a run directory (as `nadir run` writes it), or a tree of runs; without "
-                 "--headless, default out if it exists, else the current directory");
+  app.add_option(
+      "run_dir", run_dir,
+      "a run directory (as `nadir run` writes it), an LCM log, or a tree of runs; without "
+      "--headless, default out if it exists, else the current directory");
   app.add_flag("--headless", headless, "render PNG files and results.csv instead of a window");
   app.add_option("--out", out_dir, "where --headless writes its files");
   CLI11_PARSE(app, argc, argv);
@@ -80,8 +81,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     if (run_dir.empty()) run_dir = fs::is_directory("out") ? "out" : ".";
-    if (!fs::is_directory(run_dir)) {
-      std::fprintf(stderr, "nadir-plot: %s: not a directory\n", run_dir.c_str());
+    if (!fs::exists(run_dir)) {
+      std::fprintf(stderr, "nadir-plot: %s: no such folder or log\n", run_dir.c_str());
       return 1;
     }
     QApplication application(argc, argv);
@@ -105,11 +106,15 @@ int main(int argc, char** argv) {
     const std::vector<std::string> runs = nadir::gui::findRuns(run_dir);
     if (runs.empty()) {
       throw nadir::gui::RunDataError(
-          run_dir + ": no run here (a run is a folder with run.lcmlog, truth.tum or metrics.json)");
+          run_dir +
+          ": no run here (a run is a folder with run.lcmlog, truth.tum or metrics.json, or an "
+          "LCM log)");
     }
     QApplication application(argc, argv);
     for (const std::string& run : runs) {
-      const fs::path relative = fs::path(run).lexically_relative(run_dir);
+      // A loose log's files go to a folder named after it, without .lcmlog.
+      fs::path relative = fs::path(run).lexically_relative(run_dir);
+      if (relative.extension() == ".lcmlog") relative.replace_extension();
       renderRun(run, relative == "." ? fs::path(out_dir) : fs::path(out_dir) / relative);
     }
   } catch (const std::exception& error) {

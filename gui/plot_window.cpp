@@ -288,7 +288,8 @@ bool PlotWindow::openRoot(const QString& root) {
   }
   statusBar()->showMessage(runs.empty() ? root +
                                               ": no run here (a run is a folder with "
-                                              "run.lcmlog, truth.tum or metrics.json)"
+                                              "run.lcmlog, truth.tum or metrics.json, "
+                                              "or an LCM log)"
                                         : QString("%1 runs under %2").arg(runs.size()).arg(root));
   return true;
 }

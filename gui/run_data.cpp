@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr char kLogName[] = "run.lcmlog";
+constexpr char kLogExtension[] = ".lcmlog";
 constexpr char kTruthName[] = "truth.tum";
 constexpr char kMetricsName[] = "metrics.json";
 
@@ -106,76 +107,90 @@ bool isRunDir(const std::string& dir) {
 
 std::vector<std::string> findRuns(const std::string& root) {
   std::error_code error;
-  if (!fs::is_directory(root, error)) throw RunDataError(root + ": not a directory");
+  if (fs::is_regular_file(root, error) && fs::path(root).extension() == kLogExtension) {
+    return {root};
+  }
+  if (!fs::is_directory(root, error)) {
+    throw RunDataError(root + ": neither a folder nor an LCM log (*.lcmlog)");
+  }
   if (isRunDir(root)) return {root};
   std::vector<std::string> runs;
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error) throw RunDataError(root + ": cannot list the directory: " + error.message());
   for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
     if (error) throw RunDataError(root + ": cannot list the directory: " + error.message());
-    if (!it->is_directory(error) || !isRunDir(it->path().string())) continue;
-    runs.push_back(it->path().string());
-    it.disable_recursion_pending();  // a run's subfolders are not runs of their own
+    if (it->is_directory(error)) {
+      if (!isRunDir(it->path().string())) continue;
+      runs.push_back(it->path().string());
+      it.disable_recursion_pending();  // a run's subfolders are not runs of their own
+    } else if (it->path().extension() == kLogExtension && it->is_regular_file(error)) {
+      // A log on its own (not a run folder's run.lcmlog: its folder is listed instead).
+      runs.push_back(it->path().string());
+    }
   }
   std::sort(runs.begin(), runs.end());
   return runs;
 }
 
-RunData loadRun(const std::string& dir) {
-  const fs::path root(dir);
+RunData loadRun(const std::string& path) {
+  const fs::path given(path);
   std::error_code error;
-  if (!fs::is_directory(root, error)) throw RunDataError(dir + ": not a directory");
-  RunData run;
-  run.dir = dir;
+  const bool is_log_file = fs::is_regular_file(given, error);
+  if (!fs::exists(given, error)) throw RunDataError(path + ": no such folder or file");
+  if (!is_log_file && !fs::is_directory(given, error)) {
+    throw RunDataError(path + ": neither a run folder nor an LCM log");
+  }
+  // A log file's metrics.json is its run's only if it is that run's run.lcmlog.
+  const fs::path root = is_log_file ? given.parent_path() : given;
+  const bool own_metrics = !is_log_file || given.filename() == kLogName;
   try {
+    eval::EvalOptions options;
+    eval::RunMetrics metrics;
+    std::string metrics_from;
     const fs::path metrics_path = root / kMetricsName;
-    if (isFile(metrics_path)) {
-      run.metrics = eval::readMetricsJson(metrics_path.string(), &run.options);
-      run.metrics_from = metrics_path.string();
+    if (own_metrics && isFile(metrics_path)) {
+      metrics = eval::readMetricsJson(metrics_path.string(), &options);
+      metrics_from = metrics_path.string();
     }
 
-    eval::PoseTrajectory truth;
-    std::map<std::string, std::vector<eval::SourceEstimate>> estimates;
-    const fs::path log_path = root / kLogName;
+    eval::LogTrajectories recorded;
+    std::string poses_from;
+    const fs::path log_path = is_log_file ? given : root / kLogName;
     const fs::path truth_path = root / kTruthName;
     if (isFile(log_path)) {
-      eval::LogTrajectories recorded = eval::readRunLog(log_path.string());
-      truth = std::move(recorded.truth);
-      estimates = std::move(recorded.sources);
-      run.damage = std::move(recorded.damage);
-      run.poses_from = log_path.string();
+      recorded = eval::readRunLog(log_path.string());
+      poses_from = log_path.string();
     } else if (isFile(truth_path)) {
-      truth = readTumFile(truth_path);
+      recorded.truth = readTumFile(truth_path);
       for (const fs::directory_entry& entry : fs::directory_iterator(root)) {
-        const fs::path& path = entry.path();
-        if (path.extension() != ".tum" || path.filename() == kTruthName) continue;
+        const fs::path& file = entry.path();
+        if (file.extension() != ".tum" || file.filename() == kTruthName) continue;
         if (!entry.is_regular_file()) continue;
-        estimates[path.stem().string()] = trackingEstimates(readTumFile(path));
+        recorded.sources[file.stem().string()] = trackingEstimates(readTumFile(file));
       }
-      run.poses_from = truth_path.string();
+      poses_from = truth_path.string();
     } else {
-      throw RunDataError(dir + ": neither " + kLogName + " nor " + kTruthName +
+      throw RunDataError(path + ": neither " + kLogName + " nor " + kTruthName +
                          ": no poses to plot");
     }
 
-    if (run.metrics_from.empty()) {
+    if (metrics_from.empty()) {
       try {
-        run.metrics = eval::evaluate(truth, estimates, run.options);
+        metrics = eval::evaluate(recorded.truth, recorded.sources, options);
       } catch (const eval::EvalError& e) {
-        throw RunDataError(run.poses_from + ": cannot evaluate: " + e.what());
+        throw RunDataError(poses_from + ": cannot evaluate: " + e.what());
       }
     }
-    run.t0_s = truth.front().t_s;
-    for (const eval::StampedPose& pose : truth) appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
-    for (const auto& [name, source] : estimates) {
-      run.sources[name] = sourceSeries(truth, source, run.options.truth_max_gap_s);
-    }
+    RunData run = runFromPoses(path, recorded, options);
+    run.poses_from = std::move(poses_from);
+    run.metrics_from = std::move(metrics_from);
+    run.metrics = std::move(metrics);
+    return run;
   } catch (const eval::EvalError& e) {
     throw RunDataError(e.what());
   } catch (const fs::filesystem_error& e) {
-    throw RunDataError(dir + ": " + e.what());
+    throw RunDataError(path + ": " + e.what());
   }
-  return run;
 }
 
 RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,

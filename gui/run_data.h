@@ -2,10 +2,11 @@
 // The plot viewer's model of a run directory (as `nadir run` writes it), without Qt:
 // the truth and every estimate source as plain time series, and the run's metrics.
 //
-// A run is a folder holding run.lcmlog, truth.tum or metrics.json. The poses come
-// from run.lcmlog when it is there (every estimate, with its status), else from
-// truth.tum and <source>.tum (TRACKING estimates only, as TUM holds them). The
-// metrics come from metrics.json when it is there, else from eval::evaluate.
+// A run is a folder holding run.lcmlog, truth.tum or metrics.json, or an LCM log
+// file. The poses come from the log when there is one (every estimate, with its
+// status), else from truth.tum and <source>.tum (TRACKING estimates only, as TUM
+// holds them). The metrics come from the run's metrics.json when it is there, else
+// from eval::evaluate.
 
 #include <cstddef>
 #include <map>
@@ -64,14 +65,19 @@ struct RunData {
 // True if dir holds run.lcmlog, truth.tum or metrics.json.
 bool isRunDir(const std::string& dir);
 
-// Every run directory in the tree under root (root itself included), sorted by
-// path. Does not descend into a run. Throws RunDataError if root is not a directory.
+// Every run in the tree under root, sorted by path: run directories (root itself
+// included; their subfolders are not searched) and LCM logs (*.lcmlog) outside run
+// directories. A root that is a log gives itself. Throws RunDataError if root is
+// neither a folder nor a log.
 std::vector<std::string> findRuns(const std::string& root);
 
-// Loads one run. Throws RunDataError naming the file for a missing, damaged or
-// foreign file (a run.lcmlog that is not a log or has no truth, a TUM file that
-// does not parse, a metrics.json of another schema) or a run with no poses.
-RunData loadRun(const std::string& dir);
+// Loads one run: a run directory, or an LCM log file (its metrics.json is read
+// only if it is a run directory's run.lcmlog; else the metrics are computed).
+// RunData::dir is the path given. Throws RunDataError naming the file for a
+// missing, damaged or foreign file (a file that is not an LCM log, a log with no
+// truth, a TUM file that does not parse, a metrics.json of another schema) or a
+// run with no poses.
+RunData loadRun(const std::string& path);
 
 // A run of poses already read (a live bus): the series of loadRun, named `name`
 // (RunData::dir), with the metrics left empty. Throws RunDataError without truth.

@@ -7,15 +7,21 @@
 // (3, 4, 0) m, so every position error is exactly 5 m.
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/bus.h"
 #include "core/frames.h"
+#include "core/lcm_log.h"
 #include "eval/run_metrics.h"
 #include "eval/trajectory.h"
+#include "nadir/pose_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
 
 namespace nadir::gui::test {
 
@@ -76,6 +82,43 @@ inline std::filesystem::path writeTumRun(const std::string& name) {
   const std::filesystem::path dir = freshDir(name);
   eval::writeTum((dir / "truth.tum").string(), truthTrajectory());
   eval::writeTum((dir / "vo_test.tum").string(), estimateTrajectory());
+  return dir;
+}
+
+inline nadir::pose_t poseMessage(double t_s, const Eigen::Vector3d& p,
+                                 const Eigen::Quaterniond& q) {
+  nadir::pose_t msg{};
+  msg.utime = static_cast<std::int64_t>(std::llround(t_s * 1e6));
+  for (int i = 0; i < 3; ++i) msg.pos[i] = p[i];
+  core::quaternionToWire(q, msg.orientation);
+  return msg;
+}
+
+template <class Msg>
+void writeMessage(core::LcmLogWriter& writer, const std::string& channel, const Msg& msg) {
+  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
+  writer.write(msg.utime, channel, bytes.data(), bytes.size());
+}
+
+// The tiny run as `nadir run` records it (run.lcmlog: the truth on POSE_TRUTH and
+// the estimates as source vo_feature), with the fifth estimate LOST.
+inline constexpr int kLostEstimate = 4;
+inline std::filesystem::path writeLogRun(const std::string& name) {
+  const std::filesystem::path dir = freshDir(name);
+  core::LcmLogWriter writer((dir / "run.lcmlog").string());
+  for (const eval::StampedPose& pose : truthTrajectory()) {
+    writeMessage(writer, "POSE_TRUTH", poseMessage(pose.t_s, pose.p_m, pose.q));
+  }
+  const eval::PoseTrajectory estimates = estimateTrajectory();
+  for (int j = 0; j < kEstimates; ++j) {
+    const eval::StampedPose& pose = estimates[static_cast<std::size_t>(j)];
+    nadir::vo_estimate_t msg{};
+    msg.utime = poseMessage(pose.t_s, pose.p_m, pose.q).utime;
+    msg.source = "vo_feature";
+    msg.status = j == kLostEstimate ? eval::SourceEstimate::kLost : eval::SourceEstimate::kTracking;
+    msg.pose = poseMessage(pose.t_s, pose.p_m, pose.q);
+    writeMessage(writer, "POSE_VO_FEATURE", msg);
+  }
   return dir;
 }
 

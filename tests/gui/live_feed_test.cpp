@@ -28,16 +28,7 @@ namespace {
 std::int64_t utimeOf(double t_s) { return static_cast<std::int64_t>(std::llround(t_s * 1e6)); }
 
 nadir::pose_t truthMessage(double t_s) {
-  nadir::pose_t m{};
-  m.utime = utimeOf(t_s);
-  const Eigen::Vector3d p = test::truthPosition(t_s);
-  for (int i = 0; i < 3; ++i) m.pos[i] = p[i];
-  const Eigen::Quaterniond q = test::attitude();
-  m.orientation[0] = q.w();
-  m.orientation[1] = q.x();
-  m.orientation[2] = q.y();
-  m.orientation[3] = q.z();
-  return m;
+  return test::poseMessage(t_s, test::truthPosition(t_s), test::attitude());
 }
 
 nadir::vo_estimate_t estimateMessage(double t_s, int status) {

@@ -49,6 +49,22 @@ TEST(GuiPlotCli, HeadlessRendersEveryRunOfATree) {
   EXPECT_TRUE(fs::exists(out / "cell_b" / "results.csv"));
 }
 
+// A loose log in a tree is plotted into a folder named after it.
+TEST(GuiPlotCli, HeadlessRendersALooseLog) {
+  const fs::path root = test::freshDir("cli_logs");
+  fs::create_directories(root / "flights");
+  fs::copy_file(test::writeLogRun("cli_log_run") / "run.lcmlog", root / "flights" / "a.lcmlog");
+  const fs::path out = test::freshDir("cli_logs_out");
+  ASSERT_EQ(runPlot("--headless " + root.string() + " --out " + out.string()), 0);
+  std::ifstream csv(out / "flights" / "a" / "results.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  // Every error is |(3, 4, 0)| = 5 m, to the microsecond the log's stamps keep.
+  const std::size_t row = text.find("\nvo_feature,");
+  ASSERT_NE(row, std::string::npos) << text;
+  EXPECT_NEAR(std::stod(text.substr(row + 12)), 5.0, 1e-6) << text;
+  EXPECT_TRUE(fs::exists(out / "flights" / "a" / "top_view.png"));
+}
+
 TEST(GuiPlotCli, BadInputFails) {
   const fs::path empty = test::freshDir("cli_empty");
   const fs::path out = test::freshDir("cli_bad_out");
@@ -58,7 +74,7 @@ TEST(GuiPlotCli, BadInputFails) {
   const fs::path damaged = test::writeTumRun("cli_damaged");
   std::ofstream(damaged / "truth.tum", std::ios::app) << "oops\n";
   EXPECT_EQ(runPlot("--headless " + damaged.string() + " --out " + out.string()), 1);
-  // The window needs a folder, and --out is for --headless only.
+  // The window needs a folder or a log, and --out is for --headless only.
   EXPECT_EQ(runPlot((empty / "missing").string()), 1);
   EXPECT_EQ(runPlot(empty.string() + " --out " + out.string()), 1);
 }

@@ -10,11 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/bus.h"
-#include "core/lcm_log.h"
 #include "gui_test_util.h"
-#include "nadir/pose_t.hpp"
-#include "nadir/vo_estimate_t.hpp"
 
 namespace nadir::gui {
 namespace {
@@ -22,45 +18,12 @@ namespace {
 namespace fs = std::filesystem;
 using eval::SourceEstimate;
 using test::kEstimates;
+using test::kLostEstimate;
 using test::kTruthPoses;
+using test::writeLogRun;
 
 void writeText(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::trunc) << text;
-}
-
-nadir::pose_t poseMessage(double t_s, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  nadir::pose_t msg{};
-  msg.utime = static_cast<std::int64_t>(std::llround(t_s * 1e6));
-  for (int i = 0; i < 3; ++i) msg.pos[i] = p[i];
-  core::quaternionToWire(q, msg.orientation);
-  return msg;
-}
-
-template <class Msg>
-void writeMessage(core::LcmLogWriter& writer, const std::string& channel, const Msg& msg) {
-  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
-  writer.write(msg.utime, channel, bytes.data(), bytes.size());
-}
-
-// The tiny run as `nadir run` records it, with the fifth estimate LOST.
-constexpr int kLostEstimate = 4;
-fs::path writeLogRun(const std::string& name) {
-  const fs::path dir = test::freshDir(name);
-  core::LcmLogWriter writer((dir / "run.lcmlog").string());
-  for (const eval::StampedPose& pose : test::truthTrajectory()) {
-    writeMessage(writer, "POSE_TRUTH", poseMessage(pose.t_s, pose.p_m, pose.q));
-  }
-  const eval::PoseTrajectory estimates = test::estimateTrajectory();
-  for (int j = 0; j < kEstimates; ++j) {
-    const eval::StampedPose& pose = estimates[static_cast<std::size_t>(j)];
-    nadir::vo_estimate_t msg{};
-    msg.utime = poseMessage(pose.t_s, pose.p_m, pose.q).utime;
-    msg.source = "vo_feature";
-    msg.status = j == kLostEstimate ? SourceEstimate::kLost : SourceEstimate::kTracking;
-    msg.pose = poseMessage(pose.t_s, pose.p_m, pose.q);
-    writeMessage(writer, "POSE_VO_FEATURE", msg);
-  }
-  return dir;
 }
 
 TEST(GuiRunData, FindsRunsInATree) {
@@ -143,6 +106,47 @@ TEST(GuiRunData, LoadsTheLogWithStatuses) {
     }
   }
   EXPECT_NEAR(run.metrics.sources.at("vo_feature").position_rmse_m, 5.0, 1e-6);
+}
+
+// A log file is a run of its own: its poses, and metrics computed from them unless
+// it is a run folder's run.lcmlog, whose metrics.json is its run's.
+TEST(GuiRunData, LoadsALogFile) {
+  const fs::path dir = writeLogRun("log_file");
+  fs::copy_file(dir / "run.lcmlog", dir / "flight.lcmlog");
+  eval::RunMetrics metrics;
+  eval::SourceMetrics m;
+  m.position_rmse_m = 7.5;  // not what the poses give
+  metrics.sources["vo_feature"] = m;
+  eval::writeMetricsJson((dir / "metrics.json").string(), metrics, eval::EvalOptions{});
+
+  const RunData loose = loadRun((dir / "flight.lcmlog").string());
+  EXPECT_EQ(loose.dir, (dir / "flight.lcmlog").string());
+  EXPECT_EQ(fs::path(loose.poses_from), dir / "flight.lcmlog");
+  EXPECT_TRUE(loose.metrics_from.empty());
+  EXPECT_EQ(loose.truth.size(), static_cast<std::size_t>(kTruthPoses));
+  EXPECT_NEAR(loose.metrics.sources.at("vo_feature").position_rmse_m, 5.0, 1e-6);
+
+  const RunData own = loadRun((dir / "run.lcmlog").string());
+  EXPECT_EQ(fs::path(own.metrics_from), dir / "metrics.json");
+  EXPECT_DOUBLE_EQ(own.metrics.sources.at("vo_feature").position_rmse_m, 7.5);
+}
+
+// Loose logs in a tree are runs; a run folder's run.lcmlog is not listed beside
+// its folder, and a log given as the root is the only run.
+TEST(GuiRunData, FindsLooseLogs) {
+  const fs::path root = test::freshDir("loose");
+  fs::create_directories(root / "flights");
+  const fs::path run = writeLogRun("loose_run");
+  fs::copy(run, root / "run1");
+  fs::copy_file(run / "run.lcmlog", root / "flights" / "a.lcmlog");
+  writeText(root / "flights" / "notes.txt", "");
+  const std::vector<std::string> runs = findRuns(root.string());
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(fs::path(runs[0]), root / "flights" / "a.lcmlog");
+  EXPECT_EQ(fs::path(runs[1]), root / "run1");
+  EXPECT_EQ(findRuns((root / "flights" / "a.lcmlog").string()),
+            std::vector<std::string>{(root / "flights" / "a.lcmlog").string()});
+  EXPECT_THROW(findRuns((root / "flights" / "notes.txt").string()), RunDataError);
 }
 
 TEST(GuiRunData, MetricsComeFromMetricsJson) {
@@ -239,7 +243,13 @@ TEST(GuiRunData, RefusesForeignAndMissingFiles) {
   EXPECT_NE(message.find("truth.tum"), std::string::npos) << message;
 
   message = loadError(test::freshDir("x") / "missing");
-  EXPECT_NE(message.find("not a directory"), std::string::npos) << message;
+  EXPECT_NE(message.find("missing: no such folder or file"), std::string::npos) << message;
+
+  // A file given as a log must be one.
+  const fs::path text = test::freshDir("text") / "notes.lcmlog";
+  writeText(text, "not a log either\n");
+  message = loadError(text);
+  EXPECT_NE(message.find("notes.lcmlog"), std::string::npos) << message;
 }
 
 }  // namespace
