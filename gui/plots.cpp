@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <utility>
 
 namespace nadir::gui {
@@ -135,6 +136,8 @@ class ChartBuilder {
   std::unique_ptr<QChart> take() {
     setRange(x_axis_, x_range_, 0.0);
     setRange(y_axis_, y_range_, 0.05);
+    keepRoundTicks(chart_.get(), x_axis_);
+    keepRoundTicks(chart_.get(), y_axis_);
     return std::move(chart_);
   }
 
@@ -165,7 +168,6 @@ class ChartBuilder {
     lo -= pad;
     hi += pad;
     axis->setRange(lo, hi);
-    axis->applyNiceNumbers();
   }
 
   std::unique_ptr<QChart> chart_;
@@ -209,34 +211,97 @@ Figure timeFigure(const RunData& run, const std::string& name, const QString& ti
   return figure;
 }
 
-// Widens the shorter span so that both axes have the same metres per pixel.
+double metresPerPixel(const QValueAxis* axis, double length_px) {
+  return (axis->max() - axis->min()) / length_px;
+}
+
+// Fits both axes to the whole track, with the same metres per pixel.
 void equalizeAxes(QValueAxis* x_axis, QValueAxis* y_axis, const Range& x, const Range& y,
                   const QRectF& area) {
   if (area.width() <= 0 || area.height() <= 0 || x.empty() || y.empty()) return;
   const double pad = 0.05 * std::max({x.max - x.min, y.max - y.min, 1.0});
-  double x_span = x.max - x.min + 2 * pad;
-  double y_span = y.max - y.min + 2 * pad;
-  const double scale = std::max(x_span / area.width(), y_span / area.height());
-  x_span = scale * area.width();
-  y_span = scale * area.height();
+  const double scale =
+      std::max((x.max - x.min + 2 * pad) / area.width(), (y.max - y.min + 2 * pad) / area.height());
   const double x_mid = 0.5 * (x.min + x.max);
   const double y_mid = 0.5 * (y.min + y.max);
-  x_axis->setRange(x_mid - 0.5 * x_span, x_mid + 0.5 * x_span);
-  y_axis->setRange(y_mid - 0.5 * y_span, y_mid + 0.5 * y_span);
-  // Ranges fitted to pixels are not round: ticks at round multiples of one
-  // step (1, 2 or 5 times a power of ten, about 100 px apart), the same on both axes.
-  const double rough = 100.0 * scale;
-  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
-  const double step = decade * (rough < 2 * decade ? 1 : rough < 5 * decade ? 2 : 5);
-  for (QValueAxis* axis : {x_axis, y_axis}) {
-    axis->setTickType(QValueAxis::TicksDynamic);
-    axis->setTickAnchor(0.0);
-    axis->setTickInterval(step);
-    axis->setLabelFormat(step >= 1 ? "%.0f" : "%.2g");
-  }
+  x_axis->setRange(x_mid - 0.5 * scale * area.width(), x_mid + 0.5 * scale * area.width());
+  y_axis->setRange(y_mid - 0.5 * scale * area.height(), y_mid + 0.5 * scale * area.height());
+}
+
+// Keeps the same metres per pixel on both axes: fitted to the whole track (x, y)
+// while the chart is not zoomed, and after any range change (a zoom rectangle, a
+// pan) or resize of a zoomed chart by widening the axis with fewer metres per
+// pixel about its centre to match the other.
+void keepEqualScale(QChart* chart, QValueAxis* x_axis, QValueAxis* y_axis, const Range& x,
+                    const Range& y) {
+  auto adjusting = std::make_shared<bool>(false);
+  const auto match = [=] {
+    const QRectF area = chart->plotArea();
+    if (*adjusting || area.width() <= 0 || area.height() <= 0) return;
+    const double x_mpp = metresPerPixel(x_axis, area.width());
+    const double y_mpp = metresPerPixel(y_axis, area.height());
+    if (std::abs(x_mpp - y_mpp) <= 1e-9 * std::max(x_mpp, y_mpp)) return;
+    *adjusting = true;
+    QValueAxis* widened = x_mpp < y_mpp ? x_axis : y_axis;
+    const double length_px = x_mpp < y_mpp ? area.width() : area.height();
+    const double mid = 0.5 * (widened->min() + widened->max());
+    const double half = 0.5 * std::max(x_mpp, y_mpp) * length_px;
+    widened->setRange(mid - half, mid + half);
+    *adjusting = false;
+  };
+  equalizeAxes(x_axis, y_axis, x, y, chart->plotArea());
+  // The plot area is known only once the chart is laid out, and changes with it
+  // (and with the width of the tick labels). Queued: a range set while the chart
+  // is laying itself out re-enters the layout.
+  QObject::connect(
+      chart, &QChart::plotAreaChanged, chart,
+      [=](const QRectF& area) {
+        if (chart->isZoomed()) {
+          match();
+        } else {
+          *adjusting = true;
+          equalizeAxes(x_axis, y_axis, x, y, area);
+          *adjusting = false;
+        }
+      },
+      Qt::QueuedConnection);
+  // Queued: a zoom sets one axis and then the other; match the pair it leaves.
+  QObject::connect(x_axis, &QValueAxis::rangeChanged, chart, match, Qt::QueuedConnection);
+  QObject::connect(y_axis, &QValueAxis::rangeChanged, chart, match, Qt::QueuedConnection);
 }
 
 }  // namespace
+
+double roundTickStep(double span_units, double length_px, double spacing_px) {
+  if (!(span_units > 0) || !(length_px > 0)) return 1.0;
+  const double rough = span_units * std::max(spacing_px, 1.0) / length_px;
+  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
+  const double mantissa = rough / decade;
+  return decade * (mantissa < 1.5 ? 1 : mantissa < 3.5 ? 2 : mantissa < 7.5 ? 5 : 10);
+}
+
+QString tickLabelFormat(double step) {
+  const int decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
+  return QStringLiteral("%.%1f").arg(decimals);
+}
+
+void keepRoundTicks(QChart* chart, QValueAxis* axis) {
+  const auto apply = [chart, axis] {
+    const QRectF area = chart->plotArea();
+    const bool horizontal = axis->orientation() == Qt::Horizontal;
+    // Before the first layout there is no plot area: assume a 1200x800 chart's.
+    const double length_px = area.isEmpty() ? (horizontal ? 1000.0 : 600.0)
+                                            : (horizontal ? area.width() : area.height());
+    const double step = roundTickStep(axis->max() - axis->min(), length_px);
+    axis->setTickType(QValueAxis::TicksDynamic);
+    axis->setTickAnchor(0.0);
+    axis->setTickInterval(step);
+    axis->setLabelFormat(tickLabelFormat(step));
+  };
+  apply();
+  QObject::connect(axis, &QValueAxis::rangeChanged, chart, apply);
+  QObject::connect(chart, &QChart::plotAreaChanged, axis, apply);
+}
 
 Figure positionFigure(const RunData& run) {
   return timeFigure(run, "position", "Position (world NED)",
@@ -266,10 +331,7 @@ Figure errorFigure(const RunData& run) {
   std::unique_ptr<QChart> built = chart.take();
   // An error axis starts at zero: the error's size, not its wiggle, is the point.
   auto* y_axis = static_cast<QValueAxis*>(built->axes(Qt::Vertical).front());
-  if (!chart.yRange().empty()) {
-    y_axis->setRange(0, chart.yRange().max * 1.05);
-    y_axis->applyNiceNumbers();
-  }
+  if (!chart.yRange().empty()) y_axis->setRange(0, chart.yRange().max * 1.05);
   figure.charts.push_back(std::move(built));
   return figure;
 }
@@ -291,12 +353,9 @@ Figure topViewFigure(const RunData& run) {
   QValueAxis* y_axis = chart.yAxis();
   std::unique_ptr<QChart> built = chart.takeAsIs();
   QChart* raw = built.get();
-  equalizeAxes(x_axis, y_axis, x, y, raw->plotArea());
-  // The plot area is known only once the chart is laid out, and changes with it.
-  // Queued: a range set while the chart is laying itself out re-enters the layout.
-  QObject::connect(
-      raw, &QChart::plotAreaChanged, raw,
-      [=](const QRectF& area) { equalizeAxes(x_axis, y_axis, x, y, area); }, Qt::QueuedConnection);
+  keepEqualScale(raw, x_axis, y_axis, x, y);
+  keepRoundTicks(raw, x_axis);
+  keepRoundTicks(raw, y_axis);
   figure.charts.push_back(std::move(built));
   return figure;
 }

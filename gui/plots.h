@@ -13,6 +13,7 @@
 
 #include "gui/run_data.h"
 
+class QValueAxis;
 class QWidget;
 
 namespace nadir::gui {
@@ -32,10 +33,21 @@ Figure positionFigure(const RunData& run);
 Figure attitudeFigure(const RunData& run);
 // Each source's position error norm against time.
 Figure errorFigure(const RunData& run);
-// East against north, the same metres per pixel on both axes whatever the size.
+// East against north, the same metres per pixel on both axes whatever the size,
+// zoom or pan: a range set on one axis (a zoom rectangle of any shape) widens the
+// other about its centre to match.
 Figure topViewFigure(const RunData& run);
 // The four above, in that order.
 std::vector<Figure> buildFigures(const RunData& run);
+
+// A round tick step (1, 2 or 5 times a power of ten) giving ticks about
+// spacing_px apart over a span of span_units shown on length_px pixels.
+double roundTickStep(double span_units, double length_px, double spacing_px = 90.0);
+// printf format of tick labels at that step: no more decimals than it has.
+QString tickLabelFormat(double step);
+// Keeps the axis's ticks at round multiples of roundTickStep whenever its range
+// or the chart's plot area changes (zoom, pan, resize).
+void keepRoundTicks(QChart* chart, QValueAxis* axis);
 
 // A widget showing the figure's charts, which it takes over.
 std::unique_ptr<QWidget> figureWidget(Figure figure);

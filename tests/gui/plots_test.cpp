@@ -107,6 +107,92 @@ TEST_F(GuiPlots, TopViewHasTheSameScaleOnBothAxes) {
   }
 }
 
+// A zoom rectangle, tall or wide, ends with the same metres per pixel on both
+// axes and the whole rectangle still in view.
+TEST_F(GuiPlots, TopViewKeepsTheSameScaleAfterAZoomRectangle) {
+  const RunData run = loadRun(test::writeTumRun("top_view_zoom").string());
+  for (const QSizeF rectangle : {QSizeF(40, 300), QSizeF(400, 30)}) {
+    const std::unique_ptr<QWidget> widget = figureWidget(topViewFigure(run));
+    widget->setAttribute(Qt::WA_DontShowOnScreen);
+    widget->resize(900, 700);
+    widget->show();
+    for (int i = 0; i < 3; ++i) QApplication::processEvents();
+    QChart* chart = widget->findChild<QChartView*>()->chart();
+    const auto* x = static_cast<const QValueAxis*>(chart->axes(Qt::Horizontal).front());
+    const auto* y = static_cast<const QValueAxis*>(chart->axes(Qt::Vertical).front());
+    const QRectF area = chart->plotArea();
+    const QRectF zoom(area.topLeft() + QPointF(50, 60), rectangle);
+    // The rectangle's corners in metres, before the zoom.
+    const QPointF top_left = chart->mapToValue(zoom.topLeft());
+    const QPointF bottom_right = chart->mapToValue(zoom.bottomRight());
+    chart->zoomIn(zoom);
+    for (int i = 0; i < 3; ++i) QApplication::processEvents();
+    const double x_mpp = (x->max() - x->min()) / chart->plotArea().width();
+    const double y_mpp = (y->max() - y->min()) / chart->plotArea().height();
+    EXPECT_NEAR(x_mpp / y_mpp, 1.0, 1e-6) << rectangle.width() << "x" << rectangle.height();
+    EXPECT_LE(x->min(), top_left.x() + 1e-6);
+    EXPECT_GE(x->max(), bottom_right.x() - 1e-6);
+    EXPECT_LE(y->min(), bottom_right.y() + 1e-6);
+    EXPECT_GE(y->max(), top_left.y() - 1e-6);
+    // Zoomed in: the longer side of the rectangle spans the view on its axis.
+    const double x_zoom_m = bottom_right.x() - top_left.x();
+    const double y_zoom_m = top_left.y() - bottom_right.y();
+    if (rectangle.height() > rectangle.width()) {
+      EXPECT_NEAR(y->max() - y->min(), y_zoom_m, 1e-6 * y_zoom_m);
+    } else {
+      EXPECT_NEAR(x->max() - x->min(), x_zoom_m, 1e-6 * x_zoom_m);
+    }
+  }
+}
+
+// Tick steps are 1, 2 or 5 times a power of ten, about 90 px apart, and the
+// labels carry the step's decimals and no more.
+TEST_F(GuiPlots, TickStepsAreRound) {
+  EXPECT_DOUBLE_EQ(roundTickStep(37.3, 600.0), 5.0);      // 5.6 units per 90 px
+  EXPECT_DOUBLE_EQ(roundTickStep(149.44, 1000.0), 10.0);  // 13.4
+  EXPECT_DOUBLE_EQ(roundTickStep(1.0, 900.0), 0.1);       // 0.1
+  EXPECT_DOUBLE_EQ(roundTickStep(0.37, 300.0), 0.1);      // 0.111
+  EXPECT_DOUBLE_EQ(roundTickStep(2500.0, 600.0), 500.0);  // 375
+  EXPECT_DOUBLE_EQ(roundTickStep(80.0, 400.0), 20.0);     // 18
+  EXPECT_EQ(tickLabelFormat(500.0), QStringLiteral("%.0f"));
+  EXPECT_EQ(tickLabelFormat(1.0), QStringLiteral("%.0f"));
+  EXPECT_EQ(tickLabelFormat(0.2), QStringLiteral("%.1f"));
+  EXPECT_EQ(tickLabelFormat(0.05), QStringLiteral("%.2f"));
+}
+
+// Every axis of every figure keeps round ticks anchored at 0, also after a zoom.
+TEST_F(GuiPlots, AxesKeepRoundTicksAfterZoom) {
+  const RunData run = loadRun(test::writeTumRun("ticks_run").string());
+  for (Figure& figure : buildFigures(run)) {
+    const std::string name = figure.name;
+    const std::unique_ptr<QWidget> widget = figureWidget(std::move(figure));
+    widget->setAttribute(Qt::WA_DontShowOnScreen);
+    widget->resize(1000, 800);
+    widget->show();
+    for (int i = 0; i < 3; ++i) QApplication::processEvents();
+    for (QChartView* view : widget->findChildren<QChartView*>()) {
+      QChart* chart = view->chart();
+      chart->zoomIn(QRectF(chart->plotArea().topLeft() + QPointF(13, 17), QSizeF(77, 61)));
+      for (int i = 0; i < 3; ++i) QApplication::processEvents();
+      for (QAbstractAxis* abstract : chart->axes()) {
+        const auto* axis = static_cast<const QValueAxis*>(abstract);
+        EXPECT_EQ(axis->tickType(), QValueAxis::TicksDynamic) << name;
+        EXPECT_DOUBLE_EQ(axis->tickAnchor(), 0.0) << name;
+        const double step = axis->tickInterval();
+        const double mantissa = step / std::pow(10.0, std::floor(std::log10(step) + 1e-9));
+        EXPECT_TRUE(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 ||
+                    std::abs(mantissa - 5) < 1e-9)
+            << name << " step " << step;
+        const double length_px = axis->orientation() == Qt::Horizontal ? chart->plotArea().width()
+                                                                       : chart->plotArea().height();
+        const double spacing_px = step / (axis->max() - axis->min()) * length_px;
+        EXPECT_GT(spacing_px, 40.0) << name;
+        EXPECT_LT(spacing_px, 200.0) << name;
+      }
+    }
+  }
+}
+
 TEST_F(GuiPlots, AnUnwritablePathIsNamed) {
   const RunData run = loadRun(test::writeTumRun("unwritable_run").string());
   const std::string path = (test::freshDir("unwritable") / "no" / "such" / "error.png").string();
