@@ -50,9 +50,20 @@ void LiveFeed::restart() {
 
 int LiveFeed::poll() { return bus_.handleAvailable(); }
 
-std::optional<RunData> LiveFeed::run(const std::string& name) const {
+std::optional<RunData> LiveFeed::run(const std::string& name, std::string* metrics_error) const {
   if (collector_.truthPoses() == 0) return std::nullopt;
-  return runFromPoses(name, collector_.trajectories());
+  const eval::LogTrajectories recorded = collector_.trajectories();
+  RunData run = runFromPoses(name, recorded);
+  run.poses_from = "the bus";
+  if (metrics_error != nullptr) {
+    metrics_error->clear();
+    try {
+      run.metrics = eval::evaluate(recorded.truth, recorded.sources, run.options);
+    } catch (const eval::EvalError& e) {
+      *metrics_error = e.what();
+    }
+  }
+  return run;
 }
 
 }  // namespace nadir::gui

@@ -1,5 +1,5 @@
 #pragma once
-// nadir-viewer's live mode, without Qt: the truth, the estimates and the camera
+// The live mode of nadir-viewer and nadir-plot, without Qt: the truth, the estimates and the camera
 // images taken off a bus as they come, and the run they make so far.
 //
 // poll() dispatches what the bus holds; call it often (the window does from a
@@ -45,8 +45,9 @@ class LiveFeed {
   // run: what was gathered is dropped (a simulation started again).
   std::uint64_t version() const { return version_; }
   // The run so far, named `name` (RunData::dir); nothing before the first truth
-  // pose. The metrics are left empty: a live run has not ended.
-  std::optional<RunData> run(const std::string& name) const;
+  // pose. The metrics are computed only when metrics_error is given (they cost
+  // more than the series); it says why they could not be, else it is cleared.
+  std::optional<RunData> run(const std::string& name, std::string* metrics_error = nullptr) const;
   CameraFrames* frames() { return frames_.get(); }
   // How many times a new run replaced the gathered one.
   int restarts() const { return restarts_; }

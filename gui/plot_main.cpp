@@ -2,7 +2,7 @@
 // (default: out if it exists, else the current folder); --headless renders a
 // run's charts to PNG files and its error table to results.csv.
 //
-//   nadir-plot [DIR|LOG]
+//   nadir-plot [DIR|LOG] [--live [--url URL]]
 //   nadir-plot --headless RUN_DIR|LOG --out DIR
 //
 // RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
@@ -17,9 +17,12 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/bus.h"
+#include "gui/live_feed.h"
 #include "gui/plot_window.h"
 #include "gui/plots.h"
 #include "gui/run_data.h"
@@ -73,6 +76,10 @@ int main(int argc, char** argv) {
       "--headless, default out if it exists, else the current directory");
   app.add_flag("--headless", headless, "render PNG files and results.csv instead of a window");
   app.add_option("--out", out_dir, "where --headless writes its files");
+  bool live = false;
+  std::string url;
+  app.add_flag("--live", live, "also plot the run on the bus as it comes (window only)");
+  app.add_option("--url", url, "LCM URL for --live (default: $LCM_DEFAULT_URL, else LCM's)");
   CLI11_PARSE(app, argc, argv);
 
   if (!headless) {
@@ -85,10 +92,28 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "nadir-plot: %s: no such folder or log\n", run_dir.c_str());
       return 1;
     }
+    std::unique_ptr<nadir::core::Bus> bus;
+    std::unique_ptr<nadir::gui::LiveFeed> feed;
+    if (live) {
+      try {
+        bus = nadir::core::openBus(url);
+        nadir::gui::LiveFeedParams params;
+        params.camera_channel.clear();  // plots need no images
+        feed = std::make_unique<nadir::gui::LiveFeed>(*bus, params);
+      } catch (const std::exception& error) {
+        std::fprintf(stderr, "nadir-plot: %s\n", error.what());
+        return 1;
+      }
+    }
     QApplication application(argc, argv);
     nadir::gui::PlotWindow window(QString::fromStdString(run_dir));
+    if (feed) window.attachLive(*feed);
     window.show();
     return QApplication::exec();
+  }
+  if (live) {
+    std::fprintf(stderr, "nadir-plot: --live is for the window, not --headless\n");
+    return 1;
   }
   if (run_dir.empty()) {
     std::fprintf(stderr, "nadir-plot: --headless needs RUN_DIR\n");

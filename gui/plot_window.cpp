@@ -33,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "gui/live_feed.h"
 #include "gui/plots.h"
 
 namespace nadir::gui {
@@ -41,6 +42,9 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kPathRole = Qt::UserRole;
+constexpr int kLiveRole = Qt::UserRole + 1;
+// How often live mode takes the bus's messages.
+constexpr int kLivePollMs = 50;
 
 // A chart view that zooms with a rubber band and the wheel, pans with the middle
 // button (or Shift and the left button) and the arrow keys, and resets on Home
@@ -253,9 +257,15 @@ PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(paren
 
   connect(tree_, &QTreeWidget::currentItemChanged, this,
           [this](QTreeWidgetItem* item, QTreeWidgetItem*) {
-            if (item != nullptr) loadRunAt(item->data(0, kPathRole).toString());
+            if (item == nullptr) return;
+            if (item->data(0, kLiveRole).toBool()) {
+              refreshLive();
+            } else {
+              loadRunAt(item->data(0, kPathRole).toString());
+            }
           });
 
+  connect(&live_timer_, &QTimer::timeout, this, [this] { pollLive(); });
   openRoot(root);
 }
 
@@ -264,6 +274,8 @@ PlotWindow::~PlotWindow() = default;
 bool PlotWindow::openRoot(const QString& root) {
   tree_->blockSignals(true);
   tree_->clear();
+  live_item_ = nullptr;
+  addLiveItem();
   tree_->blockSignals(false);
   clearRun();
   root_ = root;
@@ -282,7 +294,7 @@ bool PlotWindow::openRoot(const QString& root) {
   }
   last_error_.clear();
   // The first run is shown at once: a single run needs no click.
-  if (tree_->topLevelItemCount() > 0) {
+  if (tree_->topLevelItemCount() > 0 && live_item_ == nullptr) {
     tree_->setCurrentItem(tree_->topLevelItem(0));
     if (!run_) return true;  // its error is in the status bar
   }
@@ -306,6 +318,86 @@ bool PlotWindow::selectRun(const QString& relative) {
     tree_->setCurrentItem(found.front());
   }
   return run_.has_value();
+}
+
+void PlotWindow::attachLive(LiveFeed& feed, int refresh_period_ms) {
+  feed_ = &feed;
+  refresh_period_ms_ = refresh_period_ms;
+  tree_->blockSignals(true);
+  addLiveItem();
+  tree_->blockSignals(false);
+  live_timer_.start(kLivePollMs);
+  tree_->setCurrentItem(live_item_);
+}
+
+void PlotWindow::addLiveItem() {
+  if (feed_ == nullptr || live_item_ != nullptr) return;
+  live_item_ = new QTreeWidgetItem({liveName()});
+  live_item_->setData(0, kLiveRole, true);
+  tree_->insertTopLevelItem(0, live_item_);
+}
+
+bool PlotWindow::liveSelected() const {
+  return live_item_ != nullptr && tree_->currentItem() == live_item_;
+}
+
+bool PlotWindow::anyChartZoomed() const {
+  for (const QChartView* view : tabs_->findChildren<QChartView*>()) {
+    if (view->chart()->isZoomed()) return true;
+  }
+  return false;
+}
+
+void PlotWindow::pollLive() {
+  if (feed_ == nullptr) return;
+  try {
+    feed_->poll();
+  } catch (const std::exception& error) {
+    live_timer_.stop();
+    fail(QStringLiteral("live: the bus failed: %1").arg(error.what()));
+    return;
+  }
+  if (!liveSelected() || feed_->version() == shown_version_) return;
+  if (since_refresh_.isValid() && since_refresh_.elapsed() < refresh_period_ms_) return;
+  if (anyChartZoomed()) {
+    statusBar()->showMessage(
+        QStringLiteral("live: paused while a chart is zoomed (View > Reset zoom resumes)"));
+    return;
+  }
+  refreshLive();
+}
+
+void PlotWindow::refreshLive() {
+  if (feed_ == nullptr) return;
+  since_refresh_.start();
+  shown_version_ = feed_->version();
+  const int tab = tabs_->currentIndex();
+  clearRun();
+  std::string metrics_error;
+  try {
+    run_ = feed_->run("live", &metrics_error);
+  } catch (const std::exception& error) {
+    fail(QString::fromStdString(error.what()));
+    return;
+  }
+  if (!run_) {
+    fail(QStringLiteral("live: waiting for the truth on %1").arg(eval::kTruthChannel));
+    return;
+  }
+  last_error_.clear();
+  showRun();
+  if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
+  QString status = QStringLiteral("live: %1 truth poses").arg(run_->truth.size());
+  for (const auto& [name, source] : run_->sources) {
+    status += QStringLiteral(", %1 %2 estimates")
+                  .arg(QString::fromStdString(name))
+                  .arg(source.pose.size());
+  }
+  if (!metrics_error.empty()) {
+    status += QStringLiteral("; no metrics yet: ") + QString::fromStdString(metrics_error);
+  }
+  if (!run_->damage.empty()) status += "; left out: " + QString::fromStdString(run_->damage);
+  statusBar()->showMessage(status);
 }
 
 void PlotWindow::loadRunAt(const QString& dir) {

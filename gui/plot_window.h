@@ -3,8 +3,12 @@
 // selected run's figures (zoomable charts) and error table on the right.
 // Errors (a damaged run, an unwritable file) go to the status bar, never abort.
 
+#include <QElapsedTimer>
 #include <QMainWindow>
 #include <QString>
+#include <QTimer>
+
+#include <cstdint>
 
 #include <memory>
 #include <optional>
@@ -16,8 +20,11 @@ class QLabel;
 class QTabWidget;
 class QTableWidget;
 class QTreeWidget;
+class QTreeWidgetItem;
 
 namespace nadir::gui {
+
+class LiveFeed;
 
 class PlotWindow : public QMainWindow {
  public:
@@ -31,6 +38,19 @@ class PlotWindow : public QMainWindow {
   // Selects the run at this path relative to the root, which loads it. False if
   // there is no such run or it does not load (the reason is in lastError()).
   bool selectRun(const QString& relative);
+
+  // Live mode: a "live" entry heads the tree; while it is selected its figures and
+  // table are rebuilt from feed (which must outlive the window) every
+  // refresh_period_ms as messages come, unless a chart is zoomed (which would be
+  // lost): View > Reset zoom resumes.
+  void attachLive(LiveFeed& feed, int refresh_period_ms = 1000);
+  // Takes the bus's messages, and refreshes the live figures when due (the
+  // window's timer calls it).
+  void pollLive();
+  // Rebuilds the live run's figures and table now.
+  void refreshLive();
+  // The tree entry of the live run.
+  static QString liveName() { return QStringLiteral("live (bus)"); }
 
   // Writes the figure in the current tab as shown, PNG or SVG by the suffix.
   bool exportFigure(const QString& path);
@@ -56,7 +76,17 @@ class PlotWindow : public QMainWindow {
   void chooseFigureExport(const QString& suffix);
   void chooseTableExport();
 
+  void addLiveItem();
+  bool liveSelected() const;
+  bool anyChartZoomed() const;
+
   QString root_;
+  LiveFeed* feed_ = nullptr;
+  QTreeWidgetItem* live_item_ = nullptr;
+  QTimer live_timer_;
+  QElapsedTimer since_refresh_;
+  int refresh_period_ms_ = 1000;
+  std::uint64_t shown_version_ = 0;
   QTreeWidget* tree_ = nullptr;
   QTabWidget* tabs_ = nullptr;
   QTableWidget* table_ = nullptr;
