@@ -1,7 +1,9 @@
 #include "gui/viewer_window.h"
 
+#include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QHBoxLayout>
 #include <QKeySequence>
@@ -160,6 +162,13 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   controls->addWidget(play_);
   controls->addWidget(slider_, 1);
   controls->addWidget(time_label_);
+  go_to_ = new QDoubleSpinBox(central);
+  go_to_->setPrefix(QStringLiteral("go to "));
+  go_to_->setSuffix(QStringLiteral(" s"));
+  go_to_->setDecimals(2);
+  go_to_->setKeyboardTracking(false);
+  go_to_->setToolTip(QStringLiteral("type a time and press Enter"));
+  controls->addWidget(go_to_);
   controls->addWidget(speed_);
   controls->addWidget(follow_);
   controls->addWidget(live_);
@@ -191,11 +200,28 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   connect(camera_run_, &QComboBox::currentIndexChanged, this, [this] {
     if (!showing_time_) showCamera();
   });
+  connect(go_to_, &QDoubleSpinBox::editingFinished, this, [this] { goTo(go_to_->value()); });
+  // Stepping through time from the keyboard, wherever the focus is.
+  const auto shortcut = [this](const QKeySequence& keys, double step_s) {
+    auto* action = new QAction(this);
+    action->setShortcut(keys);
+    action->setShortcutContext(Qt::WindowShortcut);
+    connect(action, &QAction::triggered, this, [this, step_s] { goTo(time() + step_s); });
+    addAction(action);
+  };
+  shortcut(QKeySequence(Qt::Key_Right), 1.0);
+  shortcut(QKeySequence(Qt::Key_Left), -1.0);
+  shortcut(QKeySequence(Qt::SHIFT | Qt::Key_Right), 10.0);
+  shortcut(QKeySequence(Qt::SHIFT | Qt::Key_Left), -10.0);
+  shortcut(QKeySequence(Qt::Key_Home), -1e12);
+  shortcut(QKeySequence(Qt::Key_End), 1e12);
   connect(&timer_, &QTimer::timeout, this, [this] { tick(); });
   timer_.setInterval(kTickMs);
   connect(&live_timer_, &QTimer::timeout, this, [this] { pollLive(); });
   live_timer_.setInterval(kLivePollMs);
-  statusBar()->showMessage(QStringLiteral("left drag: rotate, right drag: pan, wheel: zoom"));
+  statusBar()->showMessage(QStringLiteral(
+      "left drag: rotate, right drag: pan, wheel: zoom; Space: play, Left/Right: 1 s "
+      "(Shift: 10 s), Home/End"));
   setWindowTitle(QStringLiteral("nadir-viewer"));
   resize(1400, 800);
 
@@ -280,6 +306,7 @@ void ViewerWindow::runsChanged() {
                                  : viewerLegend(runs_));
   showing_time_ = true;
   slider_->setRange(0, static_cast<int>(std::ceil(duration_s_ * kSliderStepsPerS)));
+  go_to_->setRange(0.0, duration_s_);
   // The camera choice lists the runs by name, keeping the one chosen (the first
   // run's by default).
   QStringList names;
@@ -296,6 +323,11 @@ void ViewerWindow::runsChanged() {
   }
   showing_time_ = false;
   seek(time());
+}
+
+void ViewerWindow::goTo(double t_s) {
+  live_->setChecked(false);
+  seek(t_s);
 }
 
 void ViewerWindow::seek(double t_s) {

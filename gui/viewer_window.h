@@ -23,6 +23,7 @@
 
 class QCheckBox;
 class QComboBox;
+class QDoubleSpinBox;
 class QLabel;
 class QPushButton;
 class QSlider;
@@ -54,6 +55,8 @@ class ViewerWindow : public QMainWindow {
   double duration() const { return duration_s_; }
   // Playback time, s since each run's truth start, clamped to [0, duration()].
   void seek(double t_s);
+  // Seeks as the user does (the go-to box, the arrow keys): leaves live following.
+  void goTo(double t_s);
   double time() const { return view_->time(); }
   // The time readout as shown, "12.34 s / 60.00 s".
   QString timeText() const;
@@ -92,6 +95,7 @@ class ViewerWindow : public QMainWindow {
   QPushButton* play_ = nullptr;
   QSlider* slider_ = nullptr;
   QLabel* time_label_ = nullptr;
+  QDoubleSpinBox* go_to_ = nullptr;
   QComboBox* speed_ = nullptr;
   QCheckBox* follow_ = nullptr;
   QCheckBox* live_ = nullptr;

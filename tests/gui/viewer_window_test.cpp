@@ -4,7 +4,9 @@
 // the projection of the truth says.
 #include "gui/viewer_window.h"
 
+#include <QAction>
 #include <QApplication>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QImage>
 #include <QMouseEvent>
@@ -115,6 +117,30 @@ TEST_F(GuiViewerWindow, SeekShowsTheTimeAndTheVehicleAtTheTruth) {
   window->seek(1e9);
   EXPECT_DOUBLE_EQ(window->time(), window->duration());
   window->seek(-3.0);
+  EXPECT_DOUBLE_EQ(window->time(), 0.0);
+}
+
+// A typed time and the keyboard's steps skip there, within the playback span.
+TEST_F(GuiViewerWindow, SkipsToATypedTimeAndStepsByKey) {
+  const auto window = open({runDir()});
+  auto* go_to = window->findChild<QDoubleSpinBox*>();
+  ASSERT_NE(go_to, nullptr);
+  go_to->setValue(3.25);
+  emit go_to->editingFinished();
+  EXPECT_DOUBLE_EQ(window->time(), 3.25);
+  EXPECT_EQ(window->timeText(), QString::asprintf("3.25 s / %.2f s", window->duration()));
+  const auto press = [&](const QKeySequence& keys) {
+    for (QAction* action : window->actions()) {
+      if (action->shortcut() == keys) action->trigger();
+    }
+  };
+  press(QKeySequence(Qt::Key_Right));
+  EXPECT_DOUBLE_EQ(window->time(), 4.25);
+  press(QKeySequence(Qt::SHIFT | Qt::Key_Left));
+  EXPECT_DOUBLE_EQ(window->time(), 0.0);
+  press(QKeySequence(Qt::Key_End));
+  EXPECT_DOUBLE_EQ(window->time(), window->duration());
+  press(QKeySequence(Qt::Key_Home));
   EXPECT_DOUBLE_EQ(window->time(), 0.0);
 }
 
