@@ -13,6 +13,7 @@
 #include <QPixmap>
 #include <QPushButton>
 #include <QResizeEvent>
+#include <QSignalBlocker>
 #include <QSlider>
 #include <QSplitter>
 #include <QStatusBar>
@@ -374,6 +375,10 @@ void ViewerWindow::showTime() {
   slider_->setValue(static_cast<int>(std::lround(time() * kSliderStepsPerS)));
   showing_time_ = false;
   time_label_->setText(timeText());
+  if (!go_to_->hasFocus()) {
+    const QSignalBlocker quiet(go_to_);
+    go_to_->setValue(time());
+  }
   showCamera();
 }
 
