@@ -337,27 +337,35 @@ std::map<std::string, std::string> defaultSourceChannels() {
 TrajectoryCollector::TrajectoryCollector(std::map<std::string, std::string> source_channels)
     : source_channels_(std::move(source_channels)) {}
 
+namespace {
+
+// The pose of a pose_t; nothing for a non-finite position or a quaternion that is
+// not a rotation.
+std::optional<StampedPose> stampedPose(const nadir::pose_t& message) {
+  StampedPose pose;
+  pose.t_s = static_cast<double>(message.utime) / 1e6;
+  pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
+  if (!pose.p_m.allFinite()) return std::nullopt;
+  try {
+    pose.q = core::quaternionFromWire(message.orientation);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return pose;
+}
+
+}  // namespace
+
 bool TrajectoryCollector::add(const std::string& channel, const void* data, std::size_t size) {
   if (channel == kTruthChannel) {
     nadir::pose_t message;
-    if (!core::decodeMessage(data, size, message)) {
+    const std::optional<StampedPose> pose =
+        core::decodeMessage(data, size, message) ? stampedPose(message) : std::nullopt;
+    if (pose) {
+      truth_.push_back(*pose);
+    } else {
       ++undecodable_[channel];
-      return true;
     }
-    StampedPose pose;
-    pose.t_s = static_cast<double>(message.utime) / 1e6;
-    pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
-    try {
-      pose.q = core::quaternionFromWire(message.orientation);
-    } catch (const std::exception&) {
-      ++undecodable_[channel];
-      return true;
-    }
-    if (!pose.p_m.allFinite()) {
-      ++undecodable_[channel];
-      return true;
-    }
-    truth_.push_back(pose);
     return true;
   }
   const auto source = source_channels_.find(channel);
@@ -371,17 +379,13 @@ bool TrajectoryCollector::add(const std::string& channel, const void* data, std:
   estimate.t_s = static_cast<double>(message.utime) / 1e6;
   estimate.status = message.status;
   if (estimate.status == SourceEstimate::kTracking) {
-    estimate.p_m = Eigen::Vector3d(message.pose.pos[0], message.pose.pos[1], message.pose.pos[2]);
-    try {
-      estimate.q = core::quaternionFromWire(message.pose.orientation);
-    } catch (const std::exception&) {
+    const std::optional<StampedPose> pose = stampedPose(message.pose);
+    if (!pose) {
       ++undecodable_[channel];
       return true;
     }
-    if (!estimate.p_m.allFinite()) {
-      ++undecodable_[channel];
-      return true;
-    }
+    estimate.p_m = pose->p_m;
+    estimate.q = pose->q;
   }
   sources_[source->second].push_back(estimate);
   return true;
