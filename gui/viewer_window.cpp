@@ -231,8 +231,9 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
 
 ViewerWindow::~ViewerWindow() = default;
 
-void ViewerWindow::attachLive(LiveFeed& feed, const QString& name) {
+void ViewerWindow::attachLive(LiveFeed& feed, const QString& name, int rebuild_period_ms) {
   feed_ = &feed;
+  rebuild_period_ms_ = rebuild_period_ms;
   live_name_ = name;
   live_->setVisible(true);
   live_->setChecked(true);
@@ -252,6 +253,9 @@ void ViewerWindow::pollLive() {
     return;
   }
   if (feed_->version() == live_version_) return;
+  // Rebuilding the run costs time in its length: a few times a second is enough.
+  if (since_rebuild_.isValid() && since_rebuild_.elapsed() < rebuild_period_ms_) return;
+  since_rebuild_.start();
   live_version_ = feed_->version();
   std::optional<RunData> run = feed_->run(live_name_.toStdString());
   const bool first = run && (runs_.empty() || runs_.front().dir != run->dir);

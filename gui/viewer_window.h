@@ -39,10 +39,12 @@ class ViewerWindow : public QMainWindow {
   ~ViewerWindow() override;
 
   // Live mode: the run is taken from feed (which must outlive the window) as it
-  // grows, and is always the first run. With "Live" on, playback stays at the
-  // newest truth.
-  void attachLive(LiveFeed& feed, const QString& name);
-  // Takes what the feed holds now (the live timer calls it).
+  // grows, and is always the first run; rebuilding it costs time in its length,
+  // so it is done at most every rebuild_period_ms. With "Live" on, playback
+  // stays at the newest truth.
+  void attachLive(LiveFeed& feed, const QString& name, int rebuild_period_ms = 200);
+  // Takes the bus's messages and, when due, shows the run they make (the live
+  // timer calls it).
   void pollLive();
   bool followingLive() const;
 
@@ -109,6 +111,8 @@ class ViewerWindow : public QMainWindow {
   LiveFeed* feed_ = nullptr;
   QString live_name_;
   std::uint64_t live_version_ = 0;
+  QElapsedTimer since_rebuild_;
+  int rebuild_period_ms_ = 200;
   QImage camera_image_;
 };
 

@@ -362,7 +362,7 @@ TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
   LiveFeed feed(*bus);
   ViewerWindow window({}, std::nullopt);
   window.show();
-  window.attachLive(feed, QStringLiteral("live"));
+  window.attachLive(feed, QStringLiteral("live"), 0);
   EXPECT_TRUE(window.runs().empty());
   EXPECT_DOUBLE_EQ(window.duration(), 0.0);
 
