@@ -2,8 +2,8 @@
 // (default: out if it exists, else the current folder); --headless renders a
 // run's charts to PNG files and its error table to results.csv.
 //
-//   nadir-plot [DIR|LOG] [--live [--url URL]]
-//   nadir-plot --headless RUN_DIR|LOG --out DIR
+//   nadir-plot [DIR|LOG] [--live [--url URL]] [--run REL] [--figure NAME] [--screenshot PNG]
+//   nadir-plot --headless RUN_DIR|LOG --out DIR [--truth NAME]
 //
 // RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
 // DIR/<its path under RUN_DIR> (a loose log's without .lcmlog).
@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include <QApplication>
+#include <QTimer>
 
 #include <cstdio>
 #include <cstdlib>
@@ -41,11 +42,14 @@ void writeText(const fs::path& path, const std::string& text) {
   if (!out) throw nadir::gui::RunDataError(path.string() + ": cannot write the file");
 }
 
-void renderRun(const std::string& run_dir, const fs::path& out_dir) {
-  const nadir::gui::RunData run = nadir::gui::loadRun(run_dir);
+void renderRun(const std::string& run_dir, const fs::path& out_dir, const std::string& truth) {
+  const nadir::gui::RunData run = nadir::gui::loadRun(run_dir, truth);
   if (!run.damage.empty()) {
     std::fprintf(stderr, "nadir-plot: %s: damaged, plotting what could be read: %s\n",
                  run.poses_from.c_str(), run.damage.c_str());
+  }
+  if (!run.truth_note.empty()) {
+    std::fprintf(stderr, "nadir-plot: %s: %s\n", run_dir.c_str(), run.truth_note.c_str());
   }
   std::error_code error;
   fs::create_directories(out_dir, error);
@@ -76,10 +80,22 @@ int main(int argc, char** argv) {
       "--headless, default out if it exists, else the current directory");
   app.add_flag("--headless", headless, "render PNG files and results.csv instead of a window");
   app.add_option("--out", out_dir, "where --headless writes its files");
+  std::string truth;
+  app.add_option("--truth", truth,
+                 "the trajectory the others are compared with (default: the recorded truth, "
+                 "POSE_TRUTH or truth.tum); the window takes it for every run that has it");
   bool live = false;
   std::string url;
   app.add_flag("--live", live, "also plot the run on the bus as it comes (window only)");
   app.add_option("--url", url, "LCM URL for --live (default: $LCM_DEFAULT_URL, else LCM's)");
+  std::string select;
+  std::string figure;
+  std::string screenshot;
+  app.add_option("--run", select, "the run shown first, by its path under DIR (window only)");
+  app.add_option("--figure", figure,
+                 "the figure shown first: position, attitude, error or top_view (window only)");
+  app.add_option("--screenshot", screenshot,
+                 "save the window to this PNG once shown, and exit (window only)");
   CLI11_PARSE(app, argc, argv);
 
   if (!headless) {
@@ -106,10 +122,34 @@ int main(int argc, char** argv) {
       }
     }
     QApplication application(argc, argv);
-    nadir::gui::PlotWindow window(QString::fromStdString(run_dir));
+    nadir::gui::PlotWindow window(QString::fromStdString(run_dir), QString::fromStdString(truth));
     if (feed) window.attachLive(*feed);
+    if (!select.empty() && !window.selectRun(QString::fromStdString(select))) {
+      std::fprintf(stderr, "nadir-plot: %s\n", window.lastError().toStdString().c_str());
+      return 1;
+    }
+    if (!figure.empty() && !window.showFigure(QString::fromStdString(figure))) {
+      std::fprintf(stderr, "nadir-plot: no figure %s (position, attitude, error, top_view)\n",
+                   figure.c_str());
+      return 1;
+    }
     window.show();
+    if (!screenshot.empty()) {
+      // After the charts have laid themselves out in the shown window.
+      QTimer::singleShot(500, &window, [&window, &screenshot] {
+        if (!window.grab().save(QString::fromStdString(screenshot))) {
+          std::fprintf(stderr, "nadir-plot: cannot write %s\n", screenshot.c_str());
+          QApplication::exit(1);
+          return;
+        }
+        QApplication::exit(0);
+      });
+    }
     return QApplication::exec();
+  }
+  if (!select.empty() || !figure.empty() || !screenshot.empty()) {
+    std::fprintf(stderr, "nadir-plot: --run, --figure and --screenshot are for the window\n");
+    return 1;
   }
   if (live) {
     std::fprintf(stderr, "nadir-plot: --live is for the window, not --headless\n");
@@ -132,7 +172,7 @@ int main(int argc, char** argv) {
     if (runs.empty()) {
       throw nadir::gui::RunDataError(
           run_dir +
-          ": no run here (a run is a folder with run.lcmlog, truth.tum or metrics.json, or an "
+          ": no run here (a run is a folder with run.lcmlog, metrics.json or TUM files, or an "
           "LCM log)");
     }
     QApplication application(argc, argv);
@@ -140,7 +180,7 @@ int main(int argc, char** argv) {
       // A loose log's files go to a folder named after it, without .lcmlog.
       fs::path relative = fs::path(run).lexically_relative(run_dir);
       if (relative.extension() == ".lcmlog") relative.replace_extension();
-      renderRun(run, relative == "." ? fs::path(out_dir) : fs::path(out_dir) / relative);
+      renderRun(run, relative == "." ? fs::path(out_dir) : fs::path(out_dir) / relative, truth);
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "nadir-plot: %s\n", error.what());

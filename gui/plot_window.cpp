@@ -4,19 +4,23 @@
 #include <QApplication>
 #include <QChart>
 #include <QChartView>
+#include <QComboBox>
 #include <QDir>
 #include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QHBoxLayout>
 #include <QHeaderView>
 #include <QImage>
 #include <QKeySequence>
 #include <QLabel>
 #include <QLegend>
 #include <QLegendMarker>
+#include <QListWidget>
 #include <QMenuBar>
 #include <QMouseEvent>
 #include <QPainter>
+#include <QSignalBlocker>
 #include <QSplitter>
 #include <QStatusBar>
 #include <QSvgGenerator>
@@ -24,10 +28,13 @@
 #include <QTableWidget>
 #include <QToolBar>
 #include <QTreeWidget>
+#include <QTreeWidgetItemIterator>
 #include <QVBoxLayout>
 #include <QWheelEvent>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -41,8 +48,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kPathRole = Qt::UserRole;
+constexpr int kPathRole = Qt::UserRole;  // a run's path as findRuns gave it
 constexpr int kLiveRole = Qt::UserRole + 1;
+constexpr int kRelativeRole = Qt::UserRole + 2;  // a run's path relative to the root
 // How often live mode takes the bus's messages.
 constexpr int kLivePollMs = 50;
 
@@ -167,6 +175,20 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
   return fields;
 }
 
+// The run against another truth, with its metrics if they can be computed (a live
+// truth may be too short yet); if not, why in metrics_error. Throws RunDataError
+// for a trajectory the run does not have or that has no pose.
+RunData againstTruth(const RunData& run, const std::string& truth, std::string& metrics_error) {
+  metrics_error.clear();
+  try {
+    return compareWithTruth(run, truth, true);
+  } catch (const RunDataError& error) {
+    RunData without_metrics = compareWithTruth(run, truth, false);
+    metrics_error = error.what();
+    return without_metrics;
+  }
+}
+
 bool writeFile(const QString& path, const QByteArray& bytes) {
   QFile file(path);
   return file.open(QIODevice::WriteOnly | QIODevice::Truncate) &&
@@ -197,13 +219,32 @@ void makeLegendToggleable(QChart* chart) {
   }
 }
 
-PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(parent) {
+PlotWindow::PlotWindow(const QString& root, const QString& truth, QWidget* parent)
+    : QMainWindow(parent), preferred_truth_(truth) {
   setWindowTitle("nadir-plot");
   resize(1400, 900);
 
   tree_ = new QTreeWidget;
   tree_->setHeaderLabel("runs");
   tree_->setSelectionMode(QAbstractItemView::SingleSelection);
+  truth_box_ = new QComboBox;
+  truth_box_->setToolTip("the trajectory the others are compared with");
+  trajectories_ = new QListWidget;
+  trajectories_->setToolTip("ticked trajectories are plotted");
+  auto* trajectories_pane = new QWidget;
+  auto* trajectories_layout = new QVBoxLayout(trajectories_pane);
+  trajectories_layout->setContentsMargins(0, 0, 0, 0);
+  auto* truth_row = new QHBoxLayout;
+  truth_row->addWidget(new QLabel("truth:"));
+  truth_row->addWidget(truth_box_, 1);
+  trajectories_layout->addLayout(truth_row);
+  trajectories_layout->addWidget(new QLabel("plotted:"));
+  trajectories_layout->addWidget(trajectories_);
+  auto* left = new QSplitter(Qt::Vertical);
+  left->addWidget(tree_);
+  left->addWidget(trajectories_pane);
+  left->setStretchFactor(0, 3);
+  left->setStretchFactor(1, 1);
   tabs_ = new QTabWidget;
   message_ = new QLabel;
   message_->setWordWrap(true);
@@ -213,6 +254,13 @@ PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(paren
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
   table_->verticalHeader()->hide();
+  table_caption_ = new QLabel;
+  table_caption_->setWordWrap(true);
+  auto* table_pane = new QWidget;
+  auto* table_layout = new QVBoxLayout(table_pane);
+  table_layout->setContentsMargins(0, 0, 0, 0);
+  table_layout->addWidget(table_caption_);
+  table_layout->addWidget(table_);
 
   auto* figures = new QWidget;
   auto* figures_layout = new QVBoxLayout(figures);
@@ -221,16 +269,16 @@ PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(paren
   figures_layout->addWidget(message_);
   auto* right = new QSplitter(Qt::Vertical);
   right->addWidget(figures);
-  right->addWidget(table_);
+  right->addWidget(table_pane);
   right->setStretchFactor(0, 5);
   right->setStretchFactor(1, 1);
-  right->setSizes({720, 140});  // else the table's size hint takes half
+  right->setSizes({700, 160});  // else the table's size hint takes half
   auto* split = new QSplitter(Qt::Horizontal);
-  split->addWidget(tree_);
+  split->addWidget(left);
   split->addWidget(right);
   split->setStretchFactor(0, 1);
   split->setStretchFactor(1, 5);
-  split->setSizes({220, 1180});
+  split->setSizes({260, 1140});
   setCentralWidget(split);
 
   QMenu* file = menuBar()->addMenu("&File");
@@ -260,10 +308,15 @@ PlotWindow::PlotWindow(const QString& root, QWidget* parent) : QMainWindow(paren
             if (item == nullptr) return;
             if (item->data(0, kLiveRole).toBool()) {
               refreshLive();
-            } else {
-              loadRunAt(item->data(0, kPathRole).toString());
-            }
+            } else if (const QString path = item->data(0, kPathRole).toString(); !path.isEmpty()) {
+              loadRunAt(path);
+            }  // a folder: its runs are below it
           });
+  connect(truth_box_, &QComboBox::activated, this,
+          [this](int index) { chooseTruth(truth_box_->itemText(index)); });
+  connect(trajectories_, &QListWidget::itemChanged, this, [this](QListWidgetItem* item) {
+    setTrajectoryShown(item->text(), item->checkState() == Qt::Checked);
+  });
 
   connect(&live_timer_, &QTimer::timeout, this, [this] { pollLive(); });
   openRoot(root);
@@ -287,37 +340,119 @@ bool PlotWindow::openRoot(const QString& root) {
     return false;
   }
   setWindowTitle("nadir-plot: " + QDir(root).absolutePath());
+  QTreeWidgetItem* first_run = nullptr;
+  std::map<fs::path, QTreeWidgetItem*> folders;  // by path relative to root
   for (const std::string& run : runs) {
     const fs::path relative = fs::path(run).lexically_relative(root.toStdString());
-    auto* item = new QTreeWidgetItem(tree_, {QString::fromStdString(relative.string())});
+    // One tree level per folder of the path: a sweep's cells under the sweep.
+    QTreeWidgetItem* parent = nullptr;
+    fs::path folder;
+    for (const fs::path& part : relative.parent_path()) {
+      folder /= part;
+      QTreeWidgetItem*& item = folders[folder];
+      if (item == nullptr) {
+        const QStringList text{QString::fromStdString(part.string())};
+        item = parent ? new QTreeWidgetItem(parent, text) : new QTreeWidgetItem(tree_, text);
+        item->setExpanded(true);
+        item->setToolTip(0, QString::fromStdString(folder.string()));
+      }
+      parent = item;
+    }
+    const QStringList text{QString::fromStdString(relative.filename().string())};
+    auto* item = parent ? new QTreeWidgetItem(parent, text) : new QTreeWidgetItem(tree_, text);
     item->setData(0, kPathRole, QString::fromStdString(run));
+    item->setData(0, kRelativeRole, QString::fromStdString(relative.string()));
+    item->setToolTip(0, QString::fromStdString(relative.string()));
+    if (first_run == nullptr) first_run = item;
   }
   last_error_.clear();
   // The first run is shown at once: a single run needs no click.
-  if (tree_->topLevelItemCount() > 0 && live_item_ == nullptr) {
-    tree_->setCurrentItem(tree_->topLevelItem(0));
+  if (first_run != nullptr && live_item_ == nullptr) {
+    tree_->setCurrentItem(first_run);
     if (!run_) return true;  // its error is in the status bar
   }
   statusBar()->showMessage(runs.empty() ? root +
                                               ": no run here (a run is a folder with "
-                                              "run.lcmlog, truth.tum or metrics.json, "
+                                              "run.lcmlog, metrics.json or TUM files, "
                                               "or an LCM log)"
                                         : QString("%1 runs under %2").arg(runs.size()).arg(root));
   return true;
 }
 
 bool PlotWindow::selectRun(const QString& relative) {
-  const QList<QTreeWidgetItem*> found = tree_->findItems(relative, Qt::MatchExactly);
-  if (found.isEmpty()) {
+  QTreeWidgetItem* found = nullptr;
+  for (QTreeWidgetItemIterator it(tree_); *it != nullptr && found == nullptr; ++it) {
+    if ((*it)->data(0, kRelativeRole).toString() == relative) found = *it;
+  }
+  if (found == nullptr) {
     fail(root_ + ": no run " + relative);
     return false;
   }
-  if (tree_->currentItem() == found.front()) {
-    loadRunAt(found.front()->data(0, kPathRole).toString());
+  if (tree_->currentItem() == found) {
+    loadRunAt(found->data(0, kPathRole).toString());
   } else {
-    tree_->setCurrentItem(found.front());
+    tree_->setCurrentItem(found);
   }
   return run_.has_value();
+}
+
+bool PlotWindow::chooseTruth(const QString& name) {
+  if (!run_) {
+    fail("no run to compare: select a run first");
+    return false;
+  }
+  try {
+    run_ = againstTruth(*run_, name.toStdString(), metrics_note_);
+  } catch (const std::exception& error) {
+    fail(QString::fromStdString(error.what()));
+    showTrajectories();  // the box back on the truth that stands
+    return false;
+  }
+  // The recorded truth is no preference: each run then takes its own.
+  preferred_truth_ = name.toStdString() == trajectoryNames(*run_).front() ? QString() : name;
+  last_error_.clear();
+  const int tab = tabs_->currentIndex();
+  showRun();
+  if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
+  return true;
+}
+
+QString PlotWindow::truthName() const {
+  return run_ ? QString::fromStdString(run_->truth_name) : QString();
+}
+
+void PlotWindow::setTrajectoryShown(const QString& name, bool shown) {
+  if (shown) {
+    hidden_.erase(name.toStdString());
+  } else {
+    hidden_.insert(name.toStdString());
+  }
+  for (int i = 0; i < trajectories_->count(); ++i) {
+    QListWidgetItem* item = trajectories_->item(i);
+    if (item->text() != name) continue;
+    const QSignalBlocker quiet(trajectories_);
+    item->setCheckState(shown ? Qt::Checked : Qt::Unchecked);
+  }
+  if (!run_) return;
+  const int tab = tabs_->currentIndex();
+  showFigures();
+  if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
+}
+
+bool PlotWindow::applyPreferredTruth() {
+  if (!run_ || preferred_truth_.isEmpty()) return true;
+  const std::string wanted = preferred_truth_.toStdString();
+  const std::vector<std::string> names = trajectoryNames(*run_);
+  if (run_->truth_name == wanted || std::find(names.begin(), names.end(), wanted) == names.end()) {
+    return true;
+  }
+  try {
+    run_ = againstTruth(*run_, wanted, metrics_note_);
+  } catch (const std::exception& error) {
+    fail(QString::fromStdString(error.what()));
+    return false;
+  }
+  return true;
 }
 
 void PlotWindow::attachLive(LiveFeed& feed, int refresh_period_ms) {
@@ -373,9 +508,8 @@ void PlotWindow::refreshLive() {
   shown_version_ = feed_->version();
   const int tab = tabs_->currentIndex();
   clearRun();
-  std::string metrics_error;
   try {
-    run_ = feed_->run("live", &metrics_error);
+    run_ = feed_->run("live", &metrics_note_);
   } catch (const std::exception& error) {
     fail(QString::fromStdString(error.what()));
     return;
@@ -384,17 +518,19 @@ void PlotWindow::refreshLive() {
     fail(QStringLiteral("live: waiting for the truth on %1").arg(eval::kTruthChannel));
     return;
   }
-  last_error_.clear();
+  const bool compared = applyPreferredTruth();
+  if (compared) last_error_.clear();
   showRun();
   if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
+  if (!compared) return;  // its error stays in the status bar
   QString status = QStringLiteral("live: %1 truth poses").arg(run_->truth.size());
   for (const auto& [name, source] : run_->sources) {
     status += QStringLiteral(", %1 %2 estimates")
                   .arg(QString::fromStdString(name))
                   .arg(source.pose.size());
   }
-  if (!metrics_error.empty()) {
-    status += QStringLiteral("; no metrics yet: ") + QString::fromStdString(metrics_error);
+  if (!metrics_note_.empty()) {
+    status += QStringLiteral("; no metrics yet: ") + QString::fromStdString(metrics_note_);
   }
   if (!run_->damage.empty()) status += "; left out: " + QString::fromStdString(run_->damage);
   statusBar()->showMessage(status);
@@ -406,31 +542,64 @@ void PlotWindow::loadRunAt(const QString& dir) {
     run_ = loadRun(dir.toStdString());
   } catch (const std::exception& error) {
     fail(QString::fromStdString(error.what()));
+    showTrajectories();
     return;
   }
-  last_error_.clear();
+  const bool compared = applyPreferredTruth();
+  if (compared) last_error_.clear();
   showRun();
+  if (!compared) statusBar()->showMessage(last_error_);
 }
 
 void PlotWindow::clearRun() {
   run_.reset();
+  metrics_note_.clear();
+  removeFigures();
+  table_->clear();
+  table_->setRowCount(0);
+  table_->setColumnCount(0);
+  table_caption_->clear();
+  message_->hide();
+  tabs_->show();
+}
+
+void PlotWindow::removeFigures() {
   while (tabs_->count() > 0) {
     QWidget* page = tabs_->widget(0);
     tabs_->removeTab(0);
     delete page;
   }
-  table_->clear();
-  table_->setRowCount(0);
-  table_->setColumnCount(0);
-  message_->hide();
-  tabs_->show();
 }
 
-void PlotWindow::showRun() {
-  for (Figure& figure : buildFigures(*run_)) {
+void PlotWindow::showFigures() {
+  removeFigures();
+  for (Figure& figure : buildFigures(*run_, hidden_)) {
     const QString name = QString::fromStdString(figure.name);
     tabs_->addTab(interactiveFigure(std::move(figure)), name);
   }
+}
+
+void PlotWindow::showTrajectories() {
+  const QSignalBlocker quiet_box(truth_box_);
+  const QSignalBlocker quiet_list(trajectories_);
+  truth_box_->clear();
+  trajectories_->clear();
+  if (!run_) return;
+  for (const std::string& name : trajectoryNames(*run_)) {
+    const QString text = QString::fromStdString(name);
+    truth_box_->addItem(text);
+    auto* item = new QListWidgetItem(text, trajectories_);
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+    item->setCheckState(hidden_.contains(name) ? Qt::Unchecked : Qt::Checked);
+    const QColor color = name == run_->truth_name ? QColor(Qt::black) : sourceColor(*run_, name);
+    item->setForeground(color);
+  }
+  truth_box_->setCurrentText(QString::fromStdString(run_->truth_name));
+}
+
+void PlotWindow::showTable() {
+  table_->clear();
+  table_->setRowCount(0);
   // The table holds resultsCsv's text, so the numbers of metrics.json (and of an
   // export) exactly.
   std::istringstream csv(resultsCsv(run_->metrics));
@@ -457,11 +626,21 @@ void PlotWindow::showRun() {
       table_->setItem(row, column, cell);
     }
   }
-  QString status =
-      QString::fromStdString(run_->dir) + ": poses from " +
-      QString::fromStdString(run_->poses_from) + ", metrics " +
+  QString caption =
+      "errors against " + truthLabel(*run_) + ", metrics " +
       (run_->metrics_from.empty() ? QString("computed here")
                                   : "from " + QString::fromStdString(run_->metrics_from));
+  if (!run_->truth_note.empty()) caption += " (" + QString::fromStdString(run_->truth_note) + ")";
+  if (!metrics_note_.empty()) caption += "; none yet: " + QString::fromStdString(metrics_note_);
+  table_caption_->setText(caption);
+}
+
+void PlotWindow::showRun() {
+  showFigures();
+  showTable();
+  showTrajectories();
+  QString status = QString::fromStdString(run_->dir) + ": poses from " +
+                   QString::fromStdString(run_->poses_from);
   if (!run_->damage.empty()) {
     status += "; damaged, showing what could be read: " + QString::fromStdString(run_->damage);
   }
@@ -476,6 +655,15 @@ void PlotWindow::fail(const QString& message) {
     message_->setText(message);
     message_->show();
   }
+}
+
+bool PlotWindow::showFigure(const QString& name) {
+  for (int i = 0; i < tabs_->count(); ++i) {
+    if (tabs_->tabText(i) != name) continue;
+    tabs_->setCurrentIndex(i);
+    return true;
+  }
+  return false;
 }
 
 bool PlotWindow::exportFigure(const QString& path) {

@@ -39,6 +39,11 @@ QColor sourceColor(const RunData& run, const std::string& name) {
   return kOthers[index % std::size(kOthers)];
 }
 
+QString truthLabel(const RunData& run) {
+  if (run.truth_name == kRecordedTruthName) return QStringLiteral("truth");
+  return QString::fromStdString(run.truth_name) + QStringLiteral(" (truth)");
+}
+
 namespace {
 
 // Enough points for a 1200 px wide chart; more only slow the drawing down.
@@ -192,16 +197,20 @@ QString runName(const RunData& run) {
 using Field = std::vector<double> PoseSeries::*;
 
 // One chart per field of the pose, truth and every source on each.
-Figure timeFigure(const RunData& run, const std::string& name, const QString& title,
-                  const std::vector<std::pair<Field, QString>>& fields, bool angles) {
+Figure timeFigure(const RunData& run, const HiddenTrajectories& hidden, const std::string& name,
+                  const QString& title, const std::vector<std::pair<Field, QString>>& fields,
+                  bool angles) {
   Figure figure;
   figure.name = name;
   const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
   for (std::size_t k = 0; k < fields.size(); ++k) {
     const auto& [field, label] = fields[k];
     ChartBuilder chart(k == 0 ? title + ": " + runName(run) : QString(), "time (s)", label);
-    chart.addLine("truth", kTruthColor, 2.0, truth_t, truth_t, run.truth.*field, angles);
+    if (!hidden.contains(run.truth_name)) {
+      chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, truth_t, run.truth.*field, angles);
+    }
     for (const auto& [source, series] : run.sources) {
+      if (hidden.contains(source)) continue;
       const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
       chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
                     series.pose.*field, angles);
@@ -303,27 +312,28 @@ void keepRoundTicks(QChart* chart, QValueAxis* axis) {
   QObject::connect(chart, &QChart::plotAreaChanged, axis, apply);
 }
 
-Figure positionFigure(const RunData& run) {
-  return timeFigure(run, "position", "Position (world NED)",
+Figure positionFigure(const RunData& run, const HiddenTrajectories& hidden) {
+  return timeFigure(run, hidden, "position", "Position (world NED)",
                     {{&PoseSeries::x_m, "north x (m)"},
                      {&PoseSeries::y_m, "east y (m)"},
                      {&PoseSeries::z_m, "down z (m)"}},
                     false);
 }
 
-Figure attitudeFigure(const RunData& run) {
-  return timeFigure(run, "attitude", "Attitude (Z-Y-X)",
+Figure attitudeFigure(const RunData& run, const HiddenTrajectories& hidden) {
+  return timeFigure(run, hidden, "attitude", "Attitude (Z-Y-X)",
                     {{&PoseSeries::roll_deg, "roll (deg)"},
                      {&PoseSeries::pitch_deg, "pitch (deg)"},
                      {&PoseSeries::yaw_deg, "yaw (deg)"}},
                     true);
 }
 
-Figure errorFigure(const RunData& run) {
+Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
   Figure figure;
   figure.name = "error";
   ChartBuilder chart("Position error: " + runName(run), "time (s)", "|p_est - p_truth| (m)");
   for (const auto& [source, series] : run.sources) {
+    if (hidden.contains(source)) continue;
     const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
     chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
                   series.position_error_m);
@@ -336,13 +346,16 @@ Figure errorFigure(const RunData& run) {
   return figure;
 }
 
-Figure topViewFigure(const RunData& run) {
+Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden) {
   Figure figure;
   figure.name = "top_view";
   ChartBuilder chart("Top view: " + runName(run), "east y (m)", "north x (m)");
   const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
-  chart.addLine("truth", kTruthColor, 2.0, truth_t, run.truth.y_m, run.truth.x_m);
+  if (!hidden.contains(run.truth_name)) {
+    chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, run.truth.y_m, run.truth.x_m);
+  }
   for (const auto& [source, series] : run.sources) {
+    if (hidden.contains(source)) continue;
     const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
     chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, series.pose.y_m,
                   series.pose.x_m);
@@ -360,12 +373,12 @@ Figure topViewFigure(const RunData& run) {
   return figure;
 }
 
-std::vector<Figure> buildFigures(const RunData& run) {
+std::vector<Figure> buildFigures(const RunData& run, const HiddenTrajectories& hidden) {
   std::vector<Figure> figures;
-  figures.push_back(positionFigure(run));
-  figures.push_back(attitudeFigure(run));
-  figures.push_back(errorFigure(run));
-  figures.push_back(topViewFigure(run));
+  figures.push_back(positionFigure(run, hidden));
+  figures.push_back(attitudeFigure(run, hidden));
+  figures.push_back(errorFigure(run, hidden));
+  figures.push_back(topViewFigure(run, hidden));
   return figures;
 }
 

@@ -8,6 +8,7 @@
 #include <QColor>
 
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,13 @@ namespace nadir::gui {
 // The colour of an estimate source in every chart (and in nadir-viewer).
 QColor sourceColor(const RunData& run, const std::string& name);
 
+// The truth's legend entry: "truth", or "NAME (truth)" when another trajectory
+// than the recorded truth was chosen.
+QString truthLabel(const RunData& run);
+
+// Trajectories left out of the figures, by name (the truth's included).
+using HiddenTrajectories = std::set<std::string>;
+
 // Charts shown together, stacked top to bottom.
 struct Figure {
   std::string name;  // a file stem: position, attitude, error, top_view
@@ -28,17 +36,17 @@ struct Figure {
 };
 
 // north x, east y, down z against time (truth and each source).
-Figure positionFigure(const RunData& run);
+Figure positionFigure(const RunData& run, const HiddenTrajectories& hidden = {});
 // roll, pitch, yaw against time (truth and each source).
-Figure attitudeFigure(const RunData& run);
+Figure attitudeFigure(const RunData& run, const HiddenTrajectories& hidden = {});
 // Each source's position error norm against time.
-Figure errorFigure(const RunData& run);
+Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden = {});
 // East against north, the same metres per pixel on both axes whatever the size,
 // zoom or pan: a range set on one axis (a zoom rectangle of any shape) widens the
 // other about its centre to match.
-Figure topViewFigure(const RunData& run);
+Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden = {});
 // The four above, in that order.
-std::vector<Figure> buildFigures(const RunData& run);
+std::vector<Figure> buildFigures(const RunData& run, const HiddenTrajectories& hidden = {});
 
 // A round tick step (1, 2 or 5 times a power of ten) giving ticks about
 // spacing_px apart over a span of span_units shown on length_px pixels.

@@ -1,12 +1,15 @@
 #include "gui/run_data.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
+#include <string>
 #include <system_error>
 #include <utility>
 
@@ -23,6 +26,7 @@ constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr char kLogName[] = "run.lcmlog";
 constexpr char kLogExtension[] = ".lcmlog";
 constexpr char kTruthName[] = "truth.tum";
+constexpr char kTumExtension[] = ".tum";
 constexpr char kMetricsName[] = "metrics.json";
 
 bool isFile(const fs::path& path) {
@@ -85,10 +89,118 @@ std::vector<eval::SourceEstimate> trackingEstimates(const eval::PoseTrajectory& 
   return estimates;
 }
 
+// The TRACKING poses of a trajectory in stamp order, the first of equal stamps
+// kept, the poses as they are (a recorded truth goes through unchanged).
+eval::PoseTrajectory truthOf(std::vector<eval::SourceEstimate> estimates) {
+  std::stable_sort(
+      estimates.begin(), estimates.end(),
+      [](const eval::SourceEstimate& a, const eval::SourceEstimate& b) { return a.t_s < b.t_s; });
+  eval::PoseTrajectory truth;
+  truth.reserve(estimates.size());
+  for (const eval::SourceEstimate& e : estimates) {
+    if (e.status != eval::SourceEstimate::kTracking) continue;
+    if (!truth.empty() && e.t_s <= truth.back().t_s) continue;
+    truth.push_back({e.t_s, e.p_m, e.q});
+  }
+  return truth;
+}
+
 eval::PoseTrajectory readTumFile(const fs::path& path) {
   eval::PoseTrajectory trajectory = eval::readTum(path.string());
   if (trajectory.empty()) throw RunDataError(path.string() + ": no pose in the file");
   return trajectory;
+}
+
+std::vector<fs::path> tumFiles(const fs::path& dir) {
+  std::vector<fs::path> files;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
+    if (entry.path().extension() == kTumExtension && entry.is_regular_file(error)) {
+      files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+// The truth of a folder of TUM files without truth.tum: the first whose name says
+// it is one (groundtruth, ground_truth, truth, gt), else the first by name.
+std::string guessTruth(const std::vector<std::string>& names, std::string& note) {
+  const auto says_truth = [](const std::string& name) {
+    const std::string lower = lowercase(name);
+    return lower.find("truth") != std::string::npos || lower == "gt" ||
+           lower.rfind("gt_", 0) == 0 || (lower.size() > 3 && lower.ends_with("_gt"));
+  };
+  const auto found = std::find_if(names.begin(), names.end(), says_truth);
+  const std::string chosen = found != names.end() ? *found : names.front();
+  note = std::string("no ") + kTruthName + ": the truth is " + chosen + kTumExtension +
+         (found != names.end() ? " (its name says so)" : " (the first by name)");
+  return chosen;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+// Builds the series and metrics of a run against one of its trajectories.
+RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> read,
+                 std::string poses_from, std::string damage, const std::string& truth_name,
+                 bool compute_metrics) {
+  const auto chosen = read->by_name.find(truth_name);
+  if (chosen == read->by_name.end()) {
+    RunData named;
+    named.trajectories = read;
+    throw RunDataError(dir + ": no trajectory " + truth_name + " (it has " +
+                       joined(trajectoryNames(named)) + ")");
+  }
+  const eval::PoseTrajectory truth = truthOf(chosen->second);
+  if (truth.empty()) throw RunDataError(dir + ": " + truth_name + " has no tracked pose");
+  RunData run;
+  run.dir = dir;
+  run.poses_from = std::move(poses_from);
+  run.damage = std::move(damage);
+  run.truth_name = truth_name;
+  if (truth_name == read->recorded_truth) run.truth_note = read->recorded_truth_note;
+  run.options = read->options;
+  run.t0_s = truth.front().t_s;
+  for (const eval::StampedPose& pose : truth) appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
+  std::map<std::string, std::vector<eval::SourceEstimate>> others;
+  for (const auto& [name, estimates] : read->by_name) {
+    if (name == truth_name) continue;
+    run.sources[name] = sourceSeries(truth, estimates, read->options.truth_max_gap_s);
+    if (compute_metrics) others.emplace(name, estimates);
+  }
+  if (truth_name == kRecordedTruthName && read->recorded_metrics) {
+    run.metrics = *read->recorded_metrics;
+    run.metrics_from = read->metrics_file;
+  } else if (compute_metrics) {
+    try {
+      run.metrics = eval::evaluate(truth, others, read->options);
+    } catch (const eval::EvalError& e) {
+      throw RunDataError(run.poses_from + ": cannot evaluate against " + truth_name + ": " +
+                         e.what());
+    }
+  }
+  run.trajectories = std::move(read);
+  return run;
+}
+
+std::shared_ptr<RunTrajectories> trajectoriesOf(const eval::LogTrajectories& recorded,
+                                                const eval::EvalOptions& options) {
+  auto read = std::make_shared<RunTrajectories>();
+  read->by_name = recorded.sources;
+  read->by_name[kRecordedTruthName] = trackingEstimates(recorded.truth);
+  read->recorded_truth = kRecordedTruthName;
+  read->options = options;
+  return read;
 }
 
 void appendNumber(std::string& out, double value) {
@@ -100,9 +212,29 @@ void appendNumber(std::string& out, double value) {
 
 }  // namespace
 
+std::vector<std::string> trajectoryNames(const RunData& run) {
+  std::vector<std::string> names;
+  if (!run.trajectories) {
+    names.push_back(run.truth_name);
+    for (const auto& [name, series] : run.sources) names.push_back(name);
+    return names;
+  }
+  names.push_back(run.trajectories->recorded_truth);
+  for (const auto& [name, estimates] : run.trajectories->by_name) {
+    if (name != run.trajectories->recorded_truth) names.push_back(name);
+  }
+  return names;
+}
+
+RunData compareWithTruth(const RunData& run, const std::string& truth_name, bool compute_metrics) {
+  if (!run.trajectories) throw RunDataError(run.dir + ": the run holds no trajectories");
+  return buildRun(run.dir, run.trajectories, run.poses_from, run.damage, truth_name,
+                  compute_metrics);
+}
+
 bool isRunDir(const std::string& dir) {
   const fs::path path(dir);
-  return isFile(path / kLogName) || isFile(path / kTruthName) || isFile(path / kMetricsName);
+  return isFile(path / kLogName) || isFile(path / kMetricsName) || !tumFiles(path).empty();
 }
 
 std::vector<std::string> findRuns(const std::string& root) {
@@ -132,7 +264,7 @@ std::vector<std::string> findRuns(const std::string& root) {
   return runs;
 }
 
-RunData loadRun(const std::string& path) {
+RunData loadRun(const std::string& path, const std::string& truth_name) {
   const fs::path given(path);
   std::error_code error;
   const bool is_log_file = fs::is_regular_file(given, error);
@@ -145,47 +277,46 @@ RunData loadRun(const std::string& path) {
   const bool own_metrics = !is_log_file || given.filename() == kLogName;
   try {
     eval::EvalOptions options;
-    eval::RunMetrics metrics;
-    std::string metrics_from;
+    std::optional<eval::RunMetrics> metrics;
     const fs::path metrics_path = root / kMetricsName;
     if (own_metrics && isFile(metrics_path)) {
       metrics = eval::readMetricsJson(metrics_path.string(), &options);
-      metrics_from = metrics_path.string();
     }
 
-    eval::LogTrajectories recorded;
+    std::shared_ptr<RunTrajectories> read;
     std::string poses_from;
+    std::string damage;
     const fs::path log_path = is_log_file ? given : root / kLogName;
-    const fs::path truth_path = root / kTruthName;
+    const std::vector<fs::path> tum_files = is_log_file ? std::vector<fs::path>{} : tumFiles(root);
     if (isFile(log_path)) {
-      recorded = eval::readRunLog(log_path.string());
+      const eval::LogTrajectories recorded = eval::readRunLog(log_path.string());
+      read = trajectoriesOf(recorded, options);
       poses_from = log_path.string();
-    } else if (isFile(truth_path)) {
-      recorded.truth = readTumFile(truth_path);
-      for (const fs::directory_entry& entry : fs::directory_iterator(root)) {
-        const fs::path& file = entry.path();
-        if (file.extension() != ".tum" || file.filename() == kTruthName) continue;
-        if (!entry.is_regular_file()) continue;
-        recorded.sources[file.stem().string()] = trackingEstimates(readTumFile(file));
+      damage = recorded.damage;
+    } else if (!tum_files.empty()) {
+      read = std::make_shared<RunTrajectories>();
+      read->options = options;
+      std::vector<std::string> names;
+      fs::path truth_file;
+      for (const fs::path& file : tum_files) {
+        names.push_back(file.stem().string());
+        read->by_name[names.back()] = trackingEstimates(readTumFile(file));
       }
-      poses_from = truth_path.string();
+      read->recorded_truth = isFile(root / kTruthName)
+                                 ? std::string(kRecordedTruthName)
+                                 : guessTruth(names, read->recorded_truth_note);
+      poses_from = (root / (read->recorded_truth + kTumExtension)).string();
     } else {
-      throw RunDataError(path + ": neither " + kLogName + " nor " + kTruthName +
-                         ": no poses to plot");
+      throw RunDataError(path + ": neither " + kLogName +
+                         " nor a TUM file (*.tum): no poses to plot");
     }
-
-    if (metrics_from.empty()) {
-      try {
-        metrics = eval::evaluate(recorded.truth, recorded.sources, options);
-      } catch (const eval::EvalError& e) {
-        throw RunDataError(poses_from + ": cannot evaluate: " + e.what());
-      }
+    // metrics.json holds against the truth nadir recorded, never a guessed one.
+    if (metrics && read->recorded_truth == kRecordedTruthName) {
+      read->recorded_metrics = std::move(metrics);
+      read->metrics_file = metrics_path.string();
     }
-    RunData run = runFromPoses(path, recorded, options);
-    run.poses_from = std::move(poses_from);
-    run.metrics_from = std::move(metrics_from);
-    run.metrics = std::move(metrics);
-    return run;
+    const std::string truth = truth_name.empty() ? read->recorded_truth : truth_name;
+    return buildRun(path, std::move(read), std::move(poses_from), std::move(damage), truth, true);
   } catch (const eval::EvalError& e) {
     throw RunDataError(e.what());
   } catch (const fs::filesystem_error& e) {
@@ -196,18 +327,8 @@ RunData loadRun(const std::string& path) {
 RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,
                      const eval::EvalOptions& options) {
   if (recorded.truth.empty()) throw RunDataError(name + ": no truth pose");
-  RunData run;
-  run.dir = name;
-  run.damage = recorded.damage;
-  run.options = options;
-  run.t0_s = recorded.truth.front().t_s;
-  for (const eval::StampedPose& pose : recorded.truth) {
-    appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
-  }
-  for (const auto& [source, estimates] : recorded.sources) {
-    run.sources[source] = sourceSeries(recorded.truth, estimates, options.truth_max_gap_s);
-  }
-  return run;
+  return buildRun(name, trajectoriesOf(recorded, options), {}, recorded.damage, kRecordedTruthName,
+                  false);
 }
 
 std::string resultsCsv(const eval::RunMetrics& metrics) {

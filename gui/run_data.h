@@ -2,14 +2,18 @@
 // The plot viewer's model of a run directory (as `nadir run` writes it), without Qt:
 // the truth and every estimate source as plain time series, and the run's metrics.
 //
-// A run is a folder holding run.lcmlog, truth.tum or metrics.json, or an LCM log
-// file. The poses come from the log when there is one (every estimate, with its
-// status), else from truth.tum and <source>.tum (TRACKING estimates only, as TUM
-// holds them). The metrics come from the run's metrics.json when it is there, else
-// from eval::evaluate.
+// A run is a folder holding run.lcmlog, metrics.json or TUM files (*.tum), or an
+// LCM log file. The poses come from the log when there is one (every estimate, with
+// its status), else from the *.tum files (TRACKING estimates only, as TUM holds
+// them). Any of a run's trajectories can be the truth the others are compared with
+// (compareWithTruth); by default it is the recorded one. The metrics come from the
+// run's metrics.json when it is there and the truth is the recorded one, else from
+// eval::evaluate.
 
 #include <cstddef>
 #include <map>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,19 +54,54 @@ struct SourceSeries {
   std::vector<double> position_error_m;
 };
 
+// The name of the truth as recorded: POSE_TRUTH in a log, truth.tum in a folder.
+inline constexpr char kRecordedTruthName[] = "truth";
+
+// Every trajectory of a run as it was read, before one is chosen as the truth.
+struct RunTrajectories {
+  // By name: the recorded truth and each estimate source, in stamp order, with
+  // the estimates' statuses (a truth and a TUM file's poses are all TRACKING).
+  std::map<std::string, std::vector<eval::SourceEstimate>> by_name;
+  // The one that is the truth unless another is chosen: kRecordedTruthName when
+  // the run recorded one, else a guess (see recorded_truth_note).
+  std::string recorded_truth;
+  std::string recorded_truth_note;  // why recorded_truth was guessed; empty if it was not
+  eval::EvalOptions options;        // metrics.json's options, or the defaults
+  std::optional<eval::RunMetrics> recorded_metrics;  // metrics.json's, against recorded_truth
+  std::string metrics_file;                          // metrics.json's path, if read
+};
+
 struct RunData {
   std::string dir;
-  std::string poses_from;     // the file the poses were read from (run.lcmlog or truth.tum)
-  std::string metrics_from;   // metrics.json, or empty if the metrics were computed here
-  std::string damage;         // run.lcmlog's damage report; empty if clean
+  std::string poses_from;    // the file the poses were read from (run.lcmlog or a *.tum)
+  std::string metrics_from;  // metrics.json, or empty if the metrics were computed here
+  std::string damage;        // run.lcmlog's damage report; empty if clean
+  std::string truth_name = kRecordedTruthName;  // the trajectory the others are compared with
+  std::string truth_note;                       // why truth_name is the truth, when it was guessed
   double t0_s = 0;            // the truth's first stamp: plots show time since then
   eval::EvalOptions options;  // metrics.json's options, or the defaults used to compute
   PoseSeries truth;
-  std::map<std::string, SourceSeries> sources;
+  std::map<std::string, SourceSeries> sources;  // every trajectory but the truth
   eval::RunMetrics metrics;
+  // What was read, shared by the runs compareWithTruth makes of this one.
+  std::shared_ptr<const RunTrajectories> trajectories;
 };
 
-// True if dir holds run.lcmlog, truth.tum or metrics.json.
+// Every trajectory of the run, the truth's included: the recorded truth first,
+// then the others by name.
+std::vector<std::string> trajectoryNames(const RunData& run);
+
+// The run compared with another of its trajectories as the truth (any name of
+// trajectoryNames): the time axis starts at its first pose, the others' errors
+// are taken against it, the recorded truth becomes one of the sources, and the
+// metrics are computed (metrics.json's only hold against the recorded truth),
+// unless compute_metrics is false (the live plots' series without the cost).
+// Throws RunDataError naming the run for a name it does not have, or a
+// trajectory without a tracked pose.
+RunData compareWithTruth(const RunData& run, const std::string& truth_name,
+                         bool compute_metrics = true);
+
+// True if dir holds run.lcmlog, metrics.json or a TUM file (*.tum).
 bool isRunDir(const std::string& dir);
 
 // Every run in the tree under root, sorted by path: run directories (root itself
@@ -73,11 +112,14 @@ std::vector<std::string> findRuns(const std::string& root);
 
 // Loads one run: a run directory, or an LCM log file (its metrics.json is read
 // only if it is a run directory's run.lcmlog; else the metrics are computed).
-// RunData::dir is the path given. Throws RunDataError naming the file for a
-// missing, damaged or foreign file (a file that is not an LCM log, a log with no
-// truth, a TUM file that does not parse, a metrics.json of another schema) or a
-// run with no poses.
-RunData loadRun(const std::string& path);
+// RunData::dir is the path given. The truth is truth_name, or if that is empty the
+// recorded one: POSE_TRUTH in a log; in a folder of TUM files truth.tum, else the
+// file whose name says groundtruth, gt or truth, else the first by name (and
+// RunData::truth_note says it was guessed). Throws RunDataError naming the file
+// for a missing, damaged or foreign file (a file that is not an LCM log, a log
+// with no truth, a TUM file that does not parse, a metrics.json of another
+// schema), a run with no poses, or a truth_name it does not have.
+RunData loadRun(const std::string& path, const std::string& truth_name = {});
 
 // A run of poses already read (a live bus): the series of loadRun, named `name`
 // (RunData::dir), with the metrics left empty. Throws RunDataError without truth.

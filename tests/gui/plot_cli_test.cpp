@@ -65,6 +65,23 @@ TEST(GuiPlotCli, HeadlessRendersALooseLog) {
   EXPECT_TRUE(fs::exists(out / "flights" / "a" / "top_view.png"));
 }
 
+// --truth vo_test: the table holds the recorded truth against vo_test, 5 m off.
+TEST(GuiPlotCli, HeadlessComparesWithTheTruthGiven) {
+  const fs::path run = test::writeTumRun("cli_truth");
+  const fs::path out = test::freshDir("cli_truth_out");
+  ASSERT_EQ(runPlot("--headless " + run.string() + " --out " + out.string() + " --truth vo_test"),
+            0);
+  std::ifstream csv(out / "results.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  EXPECT_NE(text.find("\ntruth,5,"), std::string::npos) << text;
+  EXPECT_EQ(text.find("\nvo_test,"), std::string::npos) << text;
+  // A truth the run does not have fails, and writes no table.
+  const fs::path none = test::freshDir("cli_truth_none");
+  EXPECT_EQ(runPlot("--headless " + run.string() + " --out " + none.string() + " --truth vo_nope"),
+            1);
+  EXPECT_FALSE(fs::exists(none / "results.csv"));
+}
+
 TEST(GuiPlotCli, BadInputFails) {
   const fs::path empty = test::freshDir("cli_empty");
   const fs::path out = test::freshDir("cli_bad_out");

@@ -1,6 +1,7 @@
 // The interactive window under Qt's offscreen platform: the runs it lists, the
-// table against the run's metrics, the figures, legend toggling, zoom, exports,
-// and a damaged run that must not take the window down.
+// trajectories and the truth chosen, the table against the run's metrics, the
+// figures, legend toggling, zoom, exports, and a damaged run that must not take
+// the window down.
 
 #include "gui/plot_window.h"
 
@@ -8,9 +9,12 @@
 #include <QChart>
 #include <QChartView>
 #include <QColor>
+#include <QComboBox>
 #include <QImage>
+#include <QLabel>
 #include <QLegend>
 #include <QLegendMarker>
+#include <QListWidget>
 #include <QTabWidget>
 #include <QTableWidget>
 #include <QTreeWidget>
@@ -25,6 +29,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "core/bus.h"
@@ -117,7 +122,16 @@ TEST_F(GuiPlotWindow, ListsTheRunsRelativeToTheRoot) {
   ASSERT_EQ(tree->topLevelItemCount(), 3);
   EXPECT_EQ(tree->topLevelItem(0)->text(0), "computed");
   EXPECT_EQ(tree->topLevelItem(1)->text(0), "json");
-  EXPECT_EQ(tree->topLevelItem(2)->text(0), "sub/bad");
+  // A directory tree: the folder sub, its run bad below it.
+  QTreeWidgetItem* sub = tree->topLevelItem(2);
+  EXPECT_EQ(sub->text(0), "sub");
+  ASSERT_EQ(sub->childCount(), 1);
+  EXPECT_EQ(sub->child(0)->text(0), "bad");
+  EXPECT_TRUE(sub->isExpanded());
+  // Selecting a folder loads nothing: the shown run stays.
+  const RunData* shown = window.run();
+  tree->setCurrentItem(sub);
+  EXPECT_EQ(window.run(), shown);
   // The first run is shown at once.
   ASSERT_NE(window.run(), nullptr);
   EXPECT_EQ(window.figureTabs()->count(), 4);
@@ -140,6 +154,84 @@ TEST_F(GuiPlotWindow, TableShowsTheRunsMetricsExactly) {
   EXPECT_EQ(window.errorTable()->item(0, 1)->text(), "0.300");
   EXPECT_TRUE(window.errorTable()->item(0, 5)->text().isEmpty());
   EXPECT_DOUBLE_EQ(window.run()->metrics.sources.at("vo_test").tracked_pct, 87.5);
+}
+
+// The series names of a figure's first chart, legend entries or not.
+std::set<QString> seriesNames(QWidget* figure) {
+  std::set<QString> names;
+  for (QChartView* view : figure->findChildren<QChartView*>()) {
+    for (QAbstractSeries* series : view->chart()->series()) names.insert(series->name());
+    break;
+  }
+  return names;
+}
+
+TEST_F(GuiPlotWindow, ListsTheTrajectoriesAndTheTruth) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("computed"));
+  QListWidget* list = window.trajectoryList();
+  ASSERT_EQ(list->count(), 2);
+  EXPECT_EQ(list->item(0)->text(), "truth");
+  EXPECT_EQ(list->item(1)->text(), "vo_test");
+  EXPECT_EQ(list->item(1)->checkState(), Qt::Checked);
+  ASSERT_EQ(window.truthBox()->count(), 2);
+  EXPECT_EQ(window.truthBox()->currentText(), "truth");
+  EXPECT_TRUE(window.tableCaption()->text().startsWith("errors against truth, metrics computed"))
+      << window.tableCaption()->text().toStdString();
+}
+
+// json has metrics.json: against vo_test the table is computed, the recorded truth
+// 5 m off it; the choice holds for every run that has vo_test.
+TEST_F(GuiPlotWindow, ChoosingTheTruthRecomputesFiguresAndTable) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("json"));
+  window.figureTabs()->setCurrentIndex(3);
+  ASSERT_TRUE(window.chooseTruth("vo_test")) << window.lastError().toStdString();
+  EXPECT_EQ(window.truthName(), "vo_test");
+  EXPECT_EQ(window.truthBox()->currentText(), "vo_test");
+  EXPECT_EQ(window.figureTabs()->currentIndex(), 3);  // the figure looked at stays
+  EXPECT_TRUE(window.run()->metrics_from.empty());
+  ASSERT_EQ(window.errorTable()->rowCount(), 1);
+  EXPECT_EQ(window.errorTable()->item(0, 0)->text(), "truth");
+  EXPECT_NEAR(window.errorTable()->item(0, 1)->data(Qt::UserRole).toString().toDouble(), 5.0, 1e-9);
+  EXPECT_TRUE(window.tableCaption()->text().startsWith("errors against vo_test (truth)"))
+      << window.tableCaption()->text().toStdString();
+  const std::set<QString> names = seriesNames(window.figureTabs()->widget(0));
+  EXPECT_TRUE(names.contains("vo_test (truth)"));
+  EXPECT_TRUE(names.contains("truth"));
+
+  ASSERT_TRUE(window.selectRun("computed"));
+  EXPECT_EQ(window.truthName(), "vo_test");
+  // A name the run does not have is refused, and the run stays as it was.
+  EXPECT_FALSE(window.chooseTruth("vo_nope"));
+  EXPECT_NE(window.lastError().indexOf("no trajectory vo_nope"), -1);
+  EXPECT_EQ(window.truthName(), "vo_test");
+  EXPECT_EQ(window.truthBox()->currentText(), "vo_test");
+  // Back to the recorded truth: metrics.json's numbers again.
+  ASSERT_TRUE(window.chooseTruth("truth"));
+  ASSERT_TRUE(window.selectRun("json"));
+  EXPECT_EQ(window.truthName(), "truth");
+  EXPECT_EQ(window.errorTable()->item(0, 1)->data(Qt::UserRole).toString(), "0.30000000000000004");
+}
+
+TEST_F(GuiPlotWindow, AnUntickedTrajectoryIsLeftOutOfTheFigures) {
+  PlotWindow window(QString::fromStdString(makeRoot().string()));
+  ASSERT_TRUE(window.selectRun("computed"));
+  ASSERT_TRUE(seriesNames(window.figureTabs()->widget(0)).contains("vo_test"));
+  // Unticked as a user does: through the list.
+  window.trajectoryList()->item(1)->setCheckState(Qt::Unchecked);
+  for (int tab = 0; tab < window.figureTabs()->count(); ++tab) {
+    EXPECT_FALSE(seriesNames(window.figureTabs()->widget(tab)).contains("vo_test")) << tab;
+  }
+  EXPECT_TRUE(seriesNames(window.figureTabs()->widget(0)).contains("truth"));
+  EXPECT_EQ(window.errorTable()->rowCount(), 1);  // the table keeps every source
+  // It stays unticked in the next run.
+  ASSERT_TRUE(window.selectRun("json"));
+  EXPECT_EQ(window.trajectoryList()->item(1)->checkState(), Qt::Unchecked);
+  EXPECT_FALSE(seriesNames(window.figureTabs()->widget(0)).contains("vo_test"));
+  window.setTrajectoryShown("vo_test", true);
+  EXPECT_EQ(window.trajectoryList()->item(1)->checkState(), Qt::Checked);
+  EXPECT_TRUE(seriesNames(window.figureTabs()->widget(0)).contains("vo_test"));
 }
 
 TEST_F(GuiPlotWindow, ShowsTheFiguresInTabs) {

@@ -240,7 +240,7 @@ TEST(GuiRunData, RefusesForeignAndMissingFiles) {
   eval::writeMetricsJson((metrics_only / "metrics.json").string(), eval::RunMetrics{},
                          eval::EvalOptions{});
   message = loadError(metrics_only);
-  EXPECT_NE(message.find("truth.tum"), std::string::npos) << message;
+  EXPECT_NE(message.find("run.lcmlog nor a TUM file"), std::string::npos) << message;
 
   message = loadError(test::freshDir("x") / "missing");
   EXPECT_NE(message.find("missing: no such folder or file"), std::string::npos) << message;
@@ -250,6 +250,99 @@ TEST(GuiRunData, RefusesForeignAndMissingFiles) {
   writeText(text, "not a log either\n");
   message = loadError(text);
   EXPECT_NE(message.find("notes.lcmlog"), std::string::npos) << message;
+}
+
+// vo_test as the truth: the recorded truth becomes a source, 5 m from it wherever
+// vo_test's span covers it (t = 100.5 s to 109.5 s: 91 of its 101 poses).
+TEST(GuiRunData, ComparesWithAnotherTrajectoryAsTheTruth) {
+  const fs::path dir = test::writeTumRun("other_truth");
+  const RunData recorded = loadRun(dir.string());
+  EXPECT_EQ(recorded.truth_name, "truth");
+  EXPECT_TRUE(recorded.truth_note.empty());
+  EXPECT_EQ(trajectoryNames(recorded), (std::vector<std::string>{"truth", "vo_test"}));
+
+  const RunData run = compareWithTruth(recorded, "vo_test");
+  EXPECT_EQ(run.truth_name, "vo_test");
+  EXPECT_DOUBLE_EQ(run.t0_s, test::estimateStamp(0));
+  ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kEstimates));
+  EXPECT_NEAR(run.truth.x_m.front(), 8.0, 1e-9);  // (5, 2.5) + (3, 4)
+  ASSERT_EQ(run.sources.size(), 1u);
+  const SourceSeries& truth = run.sources.at("truth");
+  ASSERT_EQ(truth.pose.size(), static_cast<std::size_t>(kTruthPoses));
+  EXPECT_TRUE(std::isnan(truth.position_error_m.front()));  // t = 100 s: before vo_test
+  EXPECT_NEAR(truth.position_error_m[5], 5.0, 1e-9);        // t = 100.5 s
+  EXPECT_NEAR(truth.position_error_m[50], 5.0, 1e-9);
+  EXPECT_TRUE(std::isnan(truth.position_error_m.back()));  // t = 110 s: after it
+
+  EXPECT_TRUE(run.metrics_from.empty());
+  const eval::SourceMetrics& m = run.metrics.sources.at("truth");
+  EXPECT_EQ(m.estimates_evaluated, 91u);
+  EXPECT_NEAR(m.position_rmse_m, 5.0, 1e-9);
+  EXPECT_NEAR(m.rotation_rmse_deg, 0.0, 1e-9);
+  // The names stay the run's; back to the recorded truth gives the first run again.
+  EXPECT_EQ(trajectoryNames(run), trajectoryNames(recorded));
+  const RunData back = compareWithTruth(run, "truth");
+  EXPECT_DOUBLE_EQ(back.t0_s, test::kT0);
+  EXPECT_NEAR(back.metrics.sources.at("vo_test").position_rmse_m, 5.0, 1e-9);
+  // The same through loadRun.
+  EXPECT_EQ(loadRun(dir.string(), "vo_test").metrics.sources.at("truth").estimates_evaluated, 91u);
+}
+
+TEST(GuiRunData, MetricsJsonHoldsOnlyAgainstTheRecordedTruth) {
+  const fs::path dir = writeLogRun("json_truth");
+  eval::RunMetrics metrics;
+  eval::SourceMetrics m;
+  m.position_rmse_m = 1234.5;  // not what the poses give: must come from the file
+  metrics.sources["vo_feature"] = m;
+  eval::writeMetricsJson((dir / "metrics.json").string(), metrics, {});
+  const RunData recorded = loadRun(dir.string());
+  EXPECT_EQ(recorded.metrics.sources.at("vo_feature").position_rmse_m, 1234.5);
+  EXPECT_FALSE(recorded.metrics_from.empty());
+
+  const RunData other = compareWithTruth(recorded, "vo_feature");
+  EXPECT_TRUE(other.metrics_from.empty());
+  EXPECT_EQ(other.metrics.sources.count("vo_feature"), 0u);
+  // The LOST estimate is no truth pose: 18 of the 19.
+  EXPECT_EQ(other.truth.size(), static_cast<std::size_t>(kEstimates - 1));
+  EXPECT_NEAR(other.metrics.sources.at("truth").position_rmse_m, 5.0, 1e-6);
+  EXPECT_EQ(compareWithTruth(other, "truth").metrics.sources.at("vo_feature").position_rmse_m,
+            1234.5);
+}
+
+TEST(GuiRunData, RefusesATruthTheRunDoesNotHave) {
+  const RunData run = loadRun(test::writeTumRun("no_such_truth").string());
+  try {
+    compareWithTruth(run, "vo_nope");
+    FAIL() << "no error";
+  } catch (const RunDataError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("no trajectory vo_nope"), std::string::npos) << message;
+    EXPECT_NE(message.find("truth, vo_test"), std::string::npos) << message;  // what it has
+  }
+  EXPECT_THROW(loadRun(run.dir, "vo_nope"), RunDataError);
+}
+
+// Without truth.tum, a file whose name says truth is taken, else the first by name;
+// either way the run says it guessed.
+TEST(GuiRunData, GuessesTheTruthOfTumFilesWithoutTruthTum) {
+  const fs::path named = test::freshDir("groundtruth");
+  eval::writeTum((named / "estimate.tum").string(), test::estimateTrajectory());
+  eval::writeTum((named / "groundtruth.tum").string(), test::truthTrajectory());
+  ASSERT_TRUE(isRunDir(named.string()));
+  const RunData run = loadRun(named.string());
+  EXPECT_EQ(run.truth_name, "groundtruth");
+  EXPECT_EQ(fs::path(run.poses_from), named / "groundtruth.tum");
+  EXPECT_NE(run.truth_note.find("its name says so"), std::string::npos) << run.truth_note;
+  EXPECT_EQ(trajectoryNames(run), (std::vector<std::string>{"groundtruth", "estimate"}));
+  EXPECT_NEAR(run.metrics.sources.at("estimate").position_rmse_m, 5.0, 1e-9);
+
+  const fs::path unnamed = test::freshDir("unnamed");
+  eval::writeTum((unnamed / "b.tum").string(), test::truthTrajectory());
+  eval::writeTum((unnamed / "a.tum").string(), test::estimateTrajectory());
+  const RunData first = loadRun(unnamed.string());
+  EXPECT_EQ(first.truth_name, "a");
+  EXPECT_NE(first.truth_note.find("the first by name"), std::string::npos) << first.truth_note;
+  EXPECT_TRUE(compareWithTruth(first, "b").truth_note.empty());
 }
 
 }  // namespace
