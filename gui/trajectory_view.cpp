@@ -16,6 +16,7 @@
 #include <exception>
 #include <limits>
 
+#include "core/params.h"
 #include "gui/plots.h"
 #include "scenario/scenario.h"
 
@@ -159,14 +160,21 @@ QColor truthColor(std::size_t run_index) {
 }
 
 ViewerTerrain terrainOfScenario(const std::string& scenario_yaml) {
-  const scenario::ScenarioParams params = scenario::loadScenario(scenario_yaml);
+  scenario::ScenarioParams params = scenario::loadScenario(scenario_yaml);
   ViewerTerrain terrain;
   terrain.built = terrain::makeWorld(params.world);
   terrain.tiles = std::make_shared<terrain::TileTree>(terrain.built.world, params.tiles);
   terrain.renderer = params.renderer;
   for (const auto& [name, target] : params.targets) terrain.targets.push_back(target);
   terrain::resolveGeodeticTargets(terrain.targets, core::LocalNedFrame(terrain.built.origin));
+  terrain.scenario_path = scenario_yaml;
+  terrain.world = core::formatParamsOf(params.world);
   return terrain;
+}
+
+std::string worldOfScenario(const std::string& scenario_yaml) {
+  scenario::ScenarioParams params = scenario::loadScenario(scenario_yaml);
+  return core::formatParamsOf(params.world);
 }
 
 struct TrajectoryView::Gl {

@@ -35,11 +35,18 @@ struct ViewerTerrain {
   render::TerrainRendererParams renderer;
   // The scenario's ground targets, drawn on the terrain as the camera sees them.
   std::vector<terrain::GroundTarget> targets;
+  std::string scenario_path;  // the scenario it was built from
+  std::string world;          // its world as worldOfScenario gives it
 };
 
 // Builds the terrain of a run's scenario.yaml (throws what loadScenario and
 // makeWorld throw, naming the file or what is wrong).
 ViewerTerrain terrainOfScenario(const std::string& scenario_yaml);
+
+// The world a scenario flies over (its world parameters: kind, seed, files,
+// origin) as text: two runs whose scenarios give the same text share one world
+// frame and terrain. Throws what loadScenario throws.
+std::string worldOfScenario(const std::string& scenario_yaml);
 
 // The default surface format the view needs (OpenGL 4.5 core, a depth buffer);
 // call before the QApplication exists.
@@ -66,6 +73,8 @@ class TrajectoryView : public QOpenGLWidget {
   // Replaces the terrain drawn (nothing: plain ground).
   void setTerrain(std::optional<ViewerTerrain> terrain);
   bool hasTerrain() const { return terrain_.has_value(); }
+  // The terrain drawn, null if none.
+  const ViewerTerrain* terrain() const { return terrain_ ? &*terrain_ : nullptr; }
   // True once a drag or the wheel has moved the camera.
   bool cameraMovedByUser() const { return camera_moved_; }
   bool follow() const { return follow_; }

@@ -88,7 +88,7 @@ const std::vector<double>& ViewerWindow::speeds() {
   return kSpeeds;
 }
 
-QString viewerLegend(const std::vector<RunData>& runs) {
+QString viewerLegend(const std::vector<RunData>& runs, const std::vector<QString>& notes) {
   QStringList lines;
   for (std::size_t r = 0; r < runs.size(); ++r) {
     QStringList items;
@@ -97,8 +97,13 @@ QString viewerLegend(const std::vector<RunData>& runs) {
       items << swatch(sourceColor(runs[r], name), QString::fromStdString(name));
     }
     const QString dir = QString::fromStdString(runName(runs[r]));
-    lines << QStringLiteral("<b>%1</b>: %2")
-                 .arg(dir.toHtmlEscaped(), items.join(QStringLiteral("&nbsp;&nbsp;")));
+    QString line = QStringLiteral("<b>%1</b>: %2")
+                       .arg(dir.toHtmlEscaped(), items.join(QStringLiteral("&nbsp;&nbsp;")));
+    if (r < notes.size() && !notes[r].isEmpty()) {
+      line += QStringLiteral("&nbsp;&nbsp;<i style=\"color:#a05000\">%1</i>")
+                  .arg(notes[r].toHtmlEscaped());
+    }
+    lines << line;
   }
   return lines.join(QStringLiteral("<br>"));
 }
@@ -183,6 +188,8 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   file->addAction(QStringLiteral("Open LCM log..."), [this] { openDialog(true); });
   file->addSeparator();
   file->addAction(QStringLiteral("Quit"), QKeySequence::Quit, [this] { close(); });
+  QMenu* view = menuBar()->addMenu(QStringLiteral("&View"));
+  terrain_menu_ = view->addMenu(QStringLiteral("&Terrain"));
 
   connect(play_, &QPushButton::clicked, this, [this] { setPlaying(!playing()); });
   connect(slider_, &QSlider::valueChanged, this, [this](int value) {
@@ -291,6 +298,52 @@ void ViewerWindow::openRun(const std::string& path) {
   runsChanged();
 }
 
+bool ViewerWindow::showTerrainOf(const std::string& run_dir) {
+  if (run_dir.empty()) {
+    view_->setTerrain(std::nullopt);
+    runsChanged();
+    return true;
+  }
+  const std::string scenario = scenarioOf(run_dir);
+  if (scenario.empty()) {
+    statusBar()->showMessage(
+        QStringLiteral("%1 has no scenario.yaml: no terrain").arg(QString::fromStdString(run_dir)));
+    return false;
+  }
+  try {
+    view_->setTerrain(terrainOfScenario(scenario));
+  } catch (const std::exception& e) {
+    statusBar()->showMessage(QStringLiteral("no terrain: %1").arg(e.what()));
+    return false;
+  }
+  runsChanged();
+  return true;
+}
+
+std::string ViewerWindow::scenarioOf(const std::string& run_dir) const {
+  // The live run is no folder (a folder of its name may exist here).
+  if (feed_ != nullptr && run_dir == live_name_.toStdString()) return {};
+  return scenarioOfRun(run_dir);
+}
+
+const std::string& ViewerWindow::worldOfRun(const std::string& run_dir) {
+  auto found = run_worlds_.find(run_dir);
+  if (found == run_worlds_.end()) {
+    std::string world;
+    if (const std::string scenario = scenarioOf(run_dir); !scenario.empty()) {
+      try {
+        world = gui::worldOfScenario(scenario);
+      } catch (const std::exception& e) {
+        statusBar()->showMessage(QString::fromUtf8(e.what()));
+      }
+    }
+    found = run_worlds_.emplace(run_dir, std::move(world)).first;
+  }
+  return found->second;
+}
+
+QString ViewerWindow::legendText() const { return legend_->text(); }
+
 void ViewerWindow::openDialog(bool log_file) {
   const QString path =
       log_file ? QFileDialog::getOpenFileName(this, QStringLiteral("Open an LCM log"), QString(),
@@ -306,9 +359,43 @@ void ViewerWindow::openDialog(bool log_file) {
 
 void ViewerWindow::runsChanged() {
   duration_s_ = playbackDuration(runs_);
+  // A run over another world than the terrain's is drawn in its own frame: say so.
+  const ViewerTerrain* terrain = view_->terrain();
+  std::vector<QString> notes;
+  for (const RunData& run : runs_) {
+    const std::string& world = worldOfRun(run.dir);
+    notes.push_back(terrain != nullptr && !world.empty() && world != terrain->world
+                        ? QStringLiteral("(over another world than the terrain shown)")
+                        : QString());
+  }
   legend_->setText(runs_.empty() ? QStringLiteral("waiting for the truth on %1")
                                        .arg(QString::fromUtf8(eval::kTruthChannel))
-                                 : viewerLegend(runs_));
+                                 : viewerLegend(runs_, notes));
+  // View > Terrain: the scenario of any run that has one, or none; rebuilt only
+  // when that changes (live mode comes here several times a second).
+  std::vector<std::pair<std::string, std::string>> choices;  // run dir, scenario
+  for (const RunData& run : runs_) {
+    if (std::string scenario = scenarioOf(run.dir); !scenario.empty()) {
+      choices.emplace_back(run.dir, std::move(scenario));
+    }
+  }
+  const std::string shown = terrain != nullptr ? terrain->scenario_path : std::string();
+  if (choices != terrain_choices_ || shown != terrain_shown_) {
+    terrain_choices_ = choices;
+    terrain_shown_ = shown;
+    terrain_menu_->clear();
+    for (const auto& [dir, scenario] : choices) {
+      QAction* action = terrain_menu_->addAction(
+          QStringLiteral("of %1").arg(QString::fromStdString(fs::path(dir).filename().string())),
+          [this, dir = dir] { showTerrainOf(dir); });
+      action->setCheckable(true);
+      action->setChecked(scenario == shown);
+    }
+    QAction* none = terrain_menu_->addAction(QStringLiteral("None (plain ground)"),
+                                             [this] { showTerrainOf({}); });
+    none->setCheckable(true);
+    none->setChecked(terrain == nullptr);
+  }
   showing_time_ = true;
   slider_->setRange(0, static_cast<int>(std::ceil(duration_s_ * kSliderStepsPerS)));
   go_to_->setRange(0.0, duration_s_);

@@ -1,9 +1,9 @@
 #pragma once
-// nadir-viewer's window: the 3D view of one or more runs over the first run's
-// terrain, a chosen run's camera image beside it, and playback synchronised over
-// every run and trajectory (play/pause, seek slider, time readout, speed 0.1x to
-// 20x, follow the vehicle). Runs come from run folders and LCM logs (File menu or
-// the constructor) or, in live mode, from a LiveFeed on a bus.
+// nadir-viewer's window: the 3D view of one or more runs over the terrain of a
+// chosen run's scenario (the first's by default), a chosen run's camera image beside it, and
+// playback synchronised over every run and trajectory (play/pause, seek slider, time readout, speed
+// 0.1x to 20x, follow the vehicle). Runs come from run folders and LCM logs (File menu or the
+// constructor) or, in live mode, from a LiveFeed on a bus.
 
 #include <QElapsedTimer>
 #include <QImage>
@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gui/camera_frames.h"
@@ -25,6 +26,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
+class QMenu;
 class QPushButton;
 class QSlider;
 
@@ -51,6 +53,16 @@ class ViewerWindow : public QMainWindow {
   // Opens a run folder or an LCM log and adds it to the runs; the terrain is
   // taken from its scenario.yaml if the window has none yet. Throws RunDataError.
   void openRun(const std::string& path);
+
+  // Draws the terrain of this run's scenario.yaml (View > Terrain); false, with
+  // the reason in the status bar, if it has none or it does not build (the
+  // terrain drawn stays). An empty run_dir leaves the ground plain.
+  bool showTerrainOf(const std::string& run_dir);
+  // Runs are drawn in their own world frame: a run whose scenario flies over
+  // another world than the terrain drawn is marked so in the legend. Its
+  // world, as worldOfScenario gives it; empty if unknown (no scenario.yaml).
+  const std::string& worldOfRun(const std::string& run_dir);
+  QString legendText() const;
 
   TrajectoryView& view() { return *view_; }
   const std::vector<RunData>& runs() const { return runs_; }
@@ -84,6 +96,8 @@ class ViewerWindow : public QMainWindow {
   void runsChanged();
   void openDialog(bool log_file);
   const RunData* cameraRun() const;
+  // The run's scenario.yaml; empty for the live run and a run without one.
+  std::string scenarioOf(const std::string& run_dir) const;
   // The images of a run (live, or from its log); null with the reason in note.
   CameraFrames* framesOf(const RunData& run, std::string& note);
 
@@ -114,10 +128,15 @@ class ViewerWindow : public QMainWindow {
   QElapsedTimer since_rebuild_;
   int rebuild_period_ms_ = 200;
   QImage camera_image_;
+  QMenu* terrain_menu_ = nullptr;
+  std::vector<std::pair<std::string, std::string>> terrain_choices_;  // run dir, scenario
+  std::string terrain_shown_;                      // the scenario of the terrain drawn
+  std::map<std::string, std::string> run_worlds_;  // run dir -> worldOfRun
 };
 
-// The HTML legend: each run's truth and sources in their colours.
-QString viewerLegend(const std::vector<RunData>& runs);
+// The HTML legend: each run's truth and sources in their colours, and after the
+// run's line its note if it has one (notes are by run, none if empty).
+QString viewerLegend(const std::vector<RunData>& runs, const std::vector<QString>& notes = {});
 
 // scenario.yaml of a run folder, or beside an LCM log; empty if there is none.
 std::string scenarioOfRun(const std::string& run_path);

@@ -1,7 +1,7 @@
 // nadir-viewer's window on a real run (made by `nadir run`, see CMakeLists.txt) on a
 // display with OpenGL 4.5 core: seeking, the time readout, the vehicle marker
-// against the truth, playback, and a rendered frame whose red ribbon lies where
-// the projection of the truth says.
+// against the truth, playback, a rendered frame whose red ribbon lies where the
+// projection of the truth says, and the terrain of any run.
 #include "gui/viewer_window.h"
 
 #include <QAction>
@@ -18,6 +18,8 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <set>
@@ -446,6 +448,43 @@ TEST_F(GuiViewerWindow, OpenRunAddsARunAndItsTerrain) {
   EXPECT_EQ(window.runs().size(), 1u);
   window.openRun((fs::path(runDir()) / "run.lcmlog").string());
   EXPECT_EQ(window.runs().size(), 2u);
+}
+
+int countOf(const QString& text, const QString& part) { return static_cast<int>(text.count(part)); }
+
+// A run over another world (the fixture's scenario with another procedural seed)
+// is marked in the legend; View > Terrain draws any run's terrain, or none.
+TEST_F(GuiViewerWindow, TerrainOfAnyRunAndRunsOverAnotherWorldMarked) {
+  const auto window = open({runDir()});
+  const QString note = "over another world";
+  EXPECT_EQ(countOf(window->legendText(), note), 0);
+
+  const fs::path other = test::freshDir("other_world");
+  fs::copy_file(fs::path(runDir()) / "truth.tum", other / "truth.tum");
+  std::ifstream in(fs::path(runDir()) / "scenario.yaml");
+  std::string yaml((std::istreambuf_iterator<char>(in)), {});
+  const std::size_t seed = yaml.find("    seed: 1  # world seed");
+  ASSERT_NE(seed, std::string::npos);
+  yaml.replace(seed, 11, "    seed: 2");
+  std::ofstream(other / "scenario.yaml") << yaml;
+  window->openRun(other.string());
+  EXPECT_NE(window->worldOfRun(other.string()), window->worldOfRun(runDir()));
+  EXPECT_EQ(countOf(window->legendText(), note), 1);
+  EXPECT_LT(window->legendText().indexOf("other_world"), window->legendText().indexOf(note));
+
+  ASSERT_TRUE(window->showTerrainOf(other.string()));
+  ASSERT_NE(window->view().terrain(), nullptr);
+  EXPECT_EQ(window->view().terrain()->scenario_path, (other / "scenario.yaml").string());
+  EXPECT_EQ(countOf(window->legendText(), note), 1);  // now the fixture's run
+  EXPECT_LT(window->legendText().indexOf(note), window->legendText().indexOf("other_world"));
+
+  // A folder without scenario.yaml has no terrain to give: the one drawn stays.
+  EXPECT_FALSE(window->showTerrainOf(test::freshDir("no_scenario").string()));
+  EXPECT_EQ(window->view().terrain()->scenario_path, (other / "scenario.yaml").string());
+
+  ASSERT_TRUE(window->showTerrainOf({}));
+  EXPECT_FALSE(window->view().hasTerrain());
+  EXPECT_EQ(countOf(window->legendText(), note), 0);
 }
 
 }  // namespace
