@@ -2,7 +2,7 @@
 # Renders the pictures in docs/images: with `nadir snapshot`, what the 1280x960
 # downward camera sees at 10, 50 and 300 m above ground over the procedural
 # world and over Zion National Park (SRTM DEM, Landsat 8 imagery at 30 m); with
-# nadir-viewer, the demo's run.
+# nadir-viewer, the demo's run; with nadir-plot, the thesis's flight.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 nadir="$root/build/bin/nadir"
@@ -25,4 +25,11 @@ done
 if [[ -d "$root/out/demo" ]]; then
   xvfb-run -a -s "-screen 0 1400x1000x24" "$root/build/bin/nadir-viewer" "$root/out/demo" \
     --at 140 --screenshot "$out/nadir_viewer.png" >/dev/null
+fi
+
+# The plot viewer on the runs under out, showing the thesis's test flight (run
+# `./nadir run thesis-oscillating --no-images --out out/thesis-oscillating` first).
+if [[ -d "$root/out/thesis-oscillating" ]]; then
+  (cd "$root" && QT_QPA_PLATFORM=offscreen build/bin/nadir-plot out --run thesis-oscillating \
+    --figure top_view --screenshot "$out/nadir_plot_window.png")
 fi

@@ -227,6 +227,9 @@ PlotWindow::PlotWindow(const QString& root, const QString& truth, QWidget* paren
   tree_ = new QTreeWidget;
   tree_->setHeaderLabel("runs");
   tree_->setSelectionMode(QAbstractItemView::SingleSelection);
+  // Long names (a sweep cell's) scroll rather than being cut.
+  tree_->header()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  tree_->header()->setStretchLastSection(false);
   truth_box_ = new QComboBox;
   truth_box_->setToolTip("the trajectory the others are compared with");
   trajectories_ = new QListWidget;

@@ -301,7 +301,9 @@ void keepRoundTicks(QChart* chart, QValueAxis* axis) {
     // Before the first layout there is no plot area: assume a 1200x800 chart's.
     const double length_px = area.isEmpty() ? (horizontal ? 1000.0 : 600.0)
                                             : (horizontal ? area.width() : area.height());
-    const double step = roundTickStep(axis->max() - axis->min(), length_px);
+    const double step =
+        roundTickStep(axis->max() - axis->min(), length_px,
+                      horizontal ? kHorizontalTickSpacingPx : kVerticalTickSpacingPx);
     axis->setTickType(QValueAxis::TicksDynamic);
     axis->setTickAnchor(0.0);
     axis->setTickInterval(step);

@@ -48,9 +48,15 @@ Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden = {});
 // The four above, in that order.
 std::vector<Figure> buildFigures(const RunData& run, const HiddenTrajectories& hidden = {});
 
+// Tick spacing aimed at: wide enough for a label across, closer up the side (a
+// chart of three stacked in a window is not 150 px high).
+inline constexpr double kHorizontalTickSpacingPx = 90.0;
+inline constexpr double kVerticalTickSpacingPx = 50.0;
+
 // A round tick step (1, 2 or 5 times a power of ten) giving ticks about
 // spacing_px apart over a span of span_units shown on length_px pixels.
-double roundTickStep(double span_units, double length_px, double spacing_px = 90.0);
+double roundTickStep(double span_units, double length_px,
+                     double spacing_px = kHorizontalTickSpacingPx);
 // printf format of tick labels at that step: no more decimals than it has.
 QString tickLabelFormat(double step);
 // Keeps the axis's ticks at round multiples of roundTickStep whenever its range

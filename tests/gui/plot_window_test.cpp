@@ -428,6 +428,16 @@ TEST_F(GuiPlotWindow, LiveRunIsPlottedAsItComes) {
   EXPECT_EQ(window.run()->truth.size(), 81u);
   EXPECT_EQ(window.figureTabs()->currentIndex(), 3);  // the tab shown is kept
 
+  // The live run against its estimates as the truth, through the next refreshes:
+  // the recorded truth 5 m from them.
+  ASSERT_TRUE(window.chooseTruth("vo_feature")) << window.lastError().toStdString();
+  publish(test::kT0 + 9.0);
+  window.pollLive();
+  EXPECT_EQ(window.truthName(), "vo_feature");
+  EXPECT_EQ(window.run()->truth.size(), 18u);  // 100.5 s to 109 s every 0.5 s
+  EXPECT_NEAR(window.run()->metrics.sources.at("truth").position_rmse_m, 5.0, 1e-6);
+  ASSERT_TRUE(window.chooseTruth("truth"));
+
   // Another run in the tree is still there to look at.
   EXPECT_TRUE(window.selectRun("computed"));
   EXPECT_EQ(window.run()->dir, (makeRoot() / "computed").string());

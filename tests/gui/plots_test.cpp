@@ -186,8 +186,12 @@ TEST_F(GuiPlots, AxesKeepRoundTicksAfterZoom) {
         const double length_px = axis->orientation() == Qt::Horizontal ? chart->plotArea().width()
                                                                        : chart->plotArea().height();
         const double spacing_px = step / (axis->max() - axis->min()) * length_px;
-        EXPECT_GT(spacing_px, 40.0) << name;
-        EXPECT_LT(spacing_px, 200.0) << name;
+        // Rounding the aimed step to 1, 2, 5 or 10 (at mantissas 1.5, 3.5 and 7.5)
+        // scales it by 2/3.5 at least and 5/3.5 at most.
+        const double aimed_px = axis->orientation() == Qt::Horizontal ? kHorizontalTickSpacingPx
+                                                                      : kVerticalTickSpacingPx;
+        EXPECT_GE(spacing_px, aimed_px * 2.0 / 3.5 - 1e-6) << name;
+        EXPECT_LE(spacing_px, aimed_px * 5.0 / 3.5 + 1e-6) << name;
       }
     }
   }
