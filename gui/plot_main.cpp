@@ -2,7 +2,8 @@
 // (default: out if it exists, else the current folder); --headless renders a
 // run's charts to PNG files and its error table to results.csv.
 //
-//   nadir-plot [DIR|LOG] [--live [--url URL]] [--run REL] [--figure NAME] [--screenshot PNG]
+//   nadir-plot [DIR|LOG] [--live [--url URL]] [--truth NAME] [--run REL] [--figure NAME]
+//              [--screenshot PNG [--wait S]]
 //   nadir-plot --headless RUN_DIR|LOG --out DIR [--truth NAME]
 //
 // RUN_DIR may also be a tree of runs (a sweep): each run's files then go to
@@ -95,7 +96,10 @@ int main(int argc, char** argv) {
   app.add_option("--figure", figure,
                  "the figure shown first: position, attitude, error or top_view (window only)");
   app.add_option("--screenshot", screenshot,
-                 "save the window to this PNG once shown, and exit (window only)");
+                 "save the window to this PNG after --wait, and exit (window only)");
+  double wait_s = 0.5;
+  app.add_option("--wait", wait_s, "seconds before --screenshot (with --live: of listening)")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
   if (!headless) {
@@ -136,7 +140,7 @@ int main(int argc, char** argv) {
     window.show();
     if (!screenshot.empty()) {
       // After the charts have laid themselves out in the shown window.
-      QTimer::singleShot(500, &window, [&window, &screenshot] {
+      QTimer::singleShot(static_cast<int>(wait_s * 1000), &window, [&window, &screenshot] {
         if (!window.grab().save(QString::fromStdString(screenshot))) {
           std::fprintf(stderr, "nadir-plot: cannot write %s\n", screenshot.c_str());
           QApplication::exit(1);
@@ -148,7 +152,8 @@ int main(int argc, char** argv) {
     return QApplication::exec();
   }
   if (!select.empty() || !figure.empty() || !screenshot.empty()) {
-    std::fprintf(stderr, "nadir-plot: --run, --figure and --screenshot are for the window\n");
+    std::fprintf(stderr,
+                 "nadir-plot: --run, --figure, --screenshot and --wait are for the window\n");
     return 1;
   }
   if (live) {

@@ -634,6 +634,9 @@ void PlotWindow::showTable() {
       (run_->metrics_from.empty() ? QString("computed here")
                                   : "from " + QString::fromStdString(run_->metrics_from));
   if (!run_->truth_note.empty()) caption += " (" + QString::fromStdString(run_->truth_note) + ")";
+  if (!preferred_truth_.isEmpty() && run_->truth_name != preferred_truth_.toStdString()) {
+    caption += " (this run has no " + preferred_truth_ + ")";
+  }
   if (!metrics_note_.empty()) caption += "; none yet: " + QString::fromStdString(metrics_note_);
   table_caption_->setText(caption);
 }

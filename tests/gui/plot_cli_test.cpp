@@ -82,6 +82,28 @@ TEST(GuiPlotCli, HeadlessComparesWithTheTruthGiven) {
   EXPECT_FALSE(fs::exists(none / "results.csv"));
 }
 
+// The window from the command line: a run and a figure chosen, saved as PNG.
+TEST(GuiPlotCli, WindowScreenshotOfAChosenRunAndFigure) {
+  const fs::path root = test::freshDir("cli_window");
+  fs::create_directories(root / "sweep");
+  fs::copy(test::writeTumRun("cli_window_a"), root / "sweep" / "a");
+  fs::copy(test::writeTumRun("cli_window_b"), root / "sweep" / "b");
+  const fs::path png = root / "window.png";
+  const std::string window = "env QT_QPA_PLATFORM=offscreen " + std::string(NADIR_PLOT_BIN) + " " +
+                             root.string() + " --screenshot " + png.string();
+  const auto run = [](const std::string& command) {
+    const int status = std::system((command + " >/dev/null 2>&1").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  ASSERT_EQ(run(window + " --run sweep/b --figure top_view --wait 0.2"), 0);
+  EXPECT_GT(fs::file_size(png), 10000u);
+  fs::remove(png);
+  EXPECT_EQ(run(window + " --run sweep/c"), 1);               // no such run
+  EXPECT_EQ(run(window + " --figure sideways"), 1);           // no such figure
+  EXPECT_EQ(run(window + " --truth vo_nope --wait 0.2"), 0);  // a preference, not an error
+  EXPECT_TRUE(fs::exists(png));
+}
+
 TEST(GuiPlotCli, BadInputFails) {
   const fs::path empty = test::freshDir("cli_empty");
   const fs::path out = test::freshDir("cli_bad_out");
@@ -94,6 +116,10 @@ TEST(GuiPlotCli, BadInputFails) {
   // The window needs a folder or a log, and --out is for --headless only.
   EXPECT_EQ(runPlot((empty / "missing").string()), 1);
   EXPECT_EQ(runPlot(empty.string() + " --out " + out.string()), 1);
+  // --screenshot is for the window.
+  EXPECT_EQ(
+      runPlot("--headless " + damaged.string() + " --out " + out.string() + " --screenshot x.png"),
+      1);
 }
 
 }  // namespace

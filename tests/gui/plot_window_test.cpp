@@ -54,8 +54,9 @@ class GuiPlotWindow : public ::testing::Test {
     new QApplication(argc, argv);
   }
 
-  // root/computed (metrics from the poses), root/json (metrics.json, no RPE) and
-  // root/sub/bad (a truth.tum that does not parse).
+  // root/computed (metrics from the poses), root/json (metrics.json, no RPE),
+  // root/nameless (the estimates called vo_other) and root/sub/bad (a truth.tum
+  // that does not parse).
   static fs::path makeRoot() {
     const fs::path root = test::freshDir("window_root");
     const fs::path source = test::writeTumRun("window_source");
@@ -72,6 +73,9 @@ class GuiPlotWindow : public ::testing::Test {
     eval::writeMetricsJson((root / "json" / "metrics.json").string(), metrics, {});
     fs::create_directories(root / "sub");
     fs::copy(source, root / "sub" / "bad");
+    fs::create_directories(root / "nameless");
+    fs::copy_file(source / "truth.tum", root / "nameless" / "truth.tum");
+    fs::copy_file(source / "vo_test.tum", root / "nameless" / "vo_other.tum");
     std::ofstream(root / "sub" / "bad" / "truth.tum", std::ios::app) << "oops\n";
     return root;
   }
@@ -119,11 +123,12 @@ TEST_F(GuiPlotWindow, ListsTheRunsRelativeToTheRoot) {
   const fs::path root = makeRoot();
   PlotWindow window(QString::fromStdString(root.string()));
   QTreeWidget* tree = window.runTree();
-  ASSERT_EQ(tree->topLevelItemCount(), 3);
+  ASSERT_EQ(tree->topLevelItemCount(), 4);
   EXPECT_EQ(tree->topLevelItem(0)->text(0), "computed");
   EXPECT_EQ(tree->topLevelItem(1)->text(0), "json");
+  EXPECT_EQ(tree->topLevelItem(2)->text(0), "nameless");
   // A directory tree: the folder sub, its run bad below it.
-  QTreeWidgetItem* sub = tree->topLevelItem(2);
+  QTreeWidgetItem* sub = tree->topLevelItem(3);
   EXPECT_EQ(sub->text(0), "sub");
   ASSERT_EQ(sub->childCount(), 1);
   EXPECT_EQ(sub->child(0)->text(0), "bad");
@@ -202,6 +207,12 @@ TEST_F(GuiPlotWindow, ChoosingTheTruthRecomputesFiguresAndTable) {
 
   ASSERT_TRUE(window.selectRun("computed"));
   EXPECT_EQ(window.truthName(), "vo_test");
+  // A run without it keeps its recorded truth, and says why.
+  ASSERT_TRUE(window.selectRun("nameless"));
+  EXPECT_EQ(window.truthName(), "truth");
+  EXPECT_TRUE(window.tableCaption()->text().contains("this run has no vo_test"))
+      << window.tableCaption()->text().toStdString();
+  ASSERT_TRUE(window.selectRun("computed"));
   // A name the run does not have is refused, and the run stays as it was.
   EXPECT_FALSE(window.chooseTruth("vo_nope"));
   EXPECT_NE(window.lastError().indexOf("no trajectory vo_nope"), -1);
