@@ -16,9 +16,11 @@
 
 #include "core/bus.h"
 #include "core/clock.h"
+#include "core/params.h"
 #include "nadir/vo_estimate_t.hpp"
 #include "nodes/sim/simulator.h"
 #include "run/process.h"
+#include "run/run.h"
 #include "scenario/scenario.h"
 #include "terrain/world_factory.h"
 
@@ -62,8 +64,7 @@ struct ChannelHealth {
 }  // namespace
 
 int launchScenario(const LaunchOptions& options, std::ostream& out, const std::atomic<bool>& stop) {
-  const scenario::ScenarioParams scenario =
-      scenario::loadScenario(options.scenario, options.overrides);
+  scenario::ScenarioParams scenario = scenario::loadScenario(options.scenario, options.overrides);
   {
     // Refuse what nadir-sim would refuse before any process starts.
     const terrain::BuiltWorld built = terrain::makeWorld(scenario.world);
@@ -86,6 +87,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
                              "--out or pass --force to replace it");
   }
   fs::create_directories(out_path);
+  // The effective scenario beside the recording, as nadir run writes it: the
+  // viewers take its terrain, and it says what ran.
+  std::ofstream(out_path / "scenario.yaml")
+      << "# nadir launch " << options.scenario << ": the effective scenario\n"
+      << core::formatParamsOf(scenario);
   const std::string bin_dir = options.bin_dir.empty() ? selfDirectory() : options.bin_dir;
   const std::string url = scenario.bus.resolvedUrl();
 
@@ -266,6 +272,13 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     out << "\n";
   }
   out << "launch: recording " << recording.string() << "\n";
+  // Every run has its charts, a launch's too (a stopped one's as far as it went).
+  const RunPlots plots = renderRunPlots(recording.string(), (out_path / "plots").string(), bin_dir);
+  if (plots.problem.empty()) {
+    out << "launch: charts in " << (out_path / "plots").string() << "\n";
+  } else {
+    out << "launch: " << plots.problem << "\n";
+  }
   return result;
 }
 

@@ -171,22 +171,22 @@ RunResult runScenario(const RunOptions& options,
   return result;
 }
 
-RunPlots renderRunPlots(const std::string& run_dir) {
+RunPlots renderRunPlots(const std::string& run, const std::string& plots_dir,
+                        const std::string& bin_dir) {
   RunPlots plots;
-  const fs::path program = fs::path(selfDirectory()) / "nadir-plot";
+  const fs::path program = fs::path(bin_dir.empty() ? selfDirectory() : bin_dir) / "nadir-plot";
   if (!fs::exists(program)) {
     plots.problem = "no plots: " + program.string() + " is not built";
     return plots;
   }
-  const fs::path out = fs::path(run_dir) / "plots";
+  const fs::path out = plots_dir.empty() ? fs::path(run) / "plots" : fs::path(plots_dir);
   std::error_code error;
   fs::create_directories(out, error);
   if (error) {
     plots.problem = "no plots: cannot create " + out.string() + ": " + error.message();
     return plots;
   }
-  ChildProcess plotter("nadir-plot",
-                       {program.string(), "--headless", run_dir, "--out", out.string()},
+  ChildProcess plotter("nadir-plot", {program.string(), "--headless", run, "--out", out.string()},
                        (out / "nadir-plot.log").string());
   try {
     plotter.start();

@@ -59,13 +59,15 @@ RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress = {});
 
 struct RunPlots {
-  std::vector<std::string> png_paths;  // what nadir-plot wrote into RUN_DIR/plots
+  std::vector<std::string> png_paths;  // what nadir-plot wrote into the plots folder
   std::string problem;                 // why there are none; empty when it worked
 };
-// The run's charts: nadir-plot --headless (the program beside this one; Qt stays
-// in gui/) into run_dir/plots, its output in run_dir/plots/nadir-plot.log. A
-// missing or failing nadir-plot is reported in `problem`, not thrown: the run
-// itself is done.
-RunPlots renderRunPlots(const std::string& run_dir);
+// A run's charts: nadir-plot --headless on run (a run folder or an LCM log) into
+// plots_dir (default: run_dir/plots), its output in plots_dir/nadir-plot.log.
+// nadir-plot is the program in bin_dir (default: beside this one; Qt stays in
+// gui/). A missing or failing nadir-plot is reported in `problem`, not thrown:
+// the run itself is done.
+RunPlots renderRunPlots(const std::string& run, const std::string& plots_dir = {},
+                        const std::string& bin_dir = {});
 
 }  // namespace nadir::run

@@ -18,6 +18,7 @@
 #include "run/launch.h"
 #include "run/run.h"
 #include "run/sweep.h"
+#include "scenario/scenario.h"
 
 namespace nadir::run {
 namespace {
@@ -269,8 +270,9 @@ TEST(Sweep, TablesLikeTheThesis) {
   EXPECT_NE(csv.find("25,25,50,failed,"), std::string::npos) << csv;
 }
 
-// Live: the nodes start as processes, the scenario ends, every node stops cleanly and the
-// recording holds the truth and the camera. Needs UDP multicast (skipped without it).
+// Live: the nodes start as processes, the scenario ends, every node stops cleanly, the
+// recording holds the truth and the camera, and the scenario and the charts lie beside
+// it. Needs UDP multicast (skipped without it).
 TEST(Launch, FliesAndStopsCleanly) {
   const std::string dir = tempDir("launch");
   LaunchOptions options;
@@ -294,6 +296,13 @@ TEST(Launch, FliesAndStopsCleanly) {
   while (auto event = reader.next()) ++counts[event->channel];
   EXPECT_GE(counts["POSE_TRUTH"], 2 * 400) << out.str();
   EXPECT_GE(counts["CAMERA_DOWN"], 2 * 20) << out.str();
+  // Beside the recording: the effective scenario (the viewers' terrain) and the charts.
+  const scenario::ScenarioParams written =
+      scenario::loadScenario((fs::path(dir) / "scenario.yaml").string());
+  EXPECT_EQ(written.camera.camera.width, 160);
+  EXPECT_NE(out.str().find("launch: charts in"), std::string::npos) << out.str();
+  EXPECT_GT(fs::file_size(fs::path(dir) / "plots" / "top_view.png"), 10000u);
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "plots" / "results.csv"));
 }
 
 // A node that dies is reported with its exit status and stops the launch with status 1.
