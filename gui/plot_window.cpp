@@ -298,6 +298,8 @@ PlotWindow::PlotWindow(const QString& root, const QString& truth, QWidget* paren
          [this] { chooseFigureExport("png"); });
   action(file, "Export figure &SVG...", QKeySequence("Ctrl+Shift+E"),
          [this] { chooseFigureExport("svg"); });
+  action(file, "Export figure &data CSV...", QKeySequence("Ctrl+D"),
+         [this] { chooseFigureDataExport(); });
   action(file, "Export table &CSV...", QKeySequence("Ctrl+T"), [this] { chooseTableExport(); });
   file->addSeparator();
   QAction* quit = file->addAction("&Quit");
@@ -725,7 +727,20 @@ bool PlotWindow::exportTableCsv(const QString& path) {
     fail("no table to export: select a run first");
     return false;
   }
-  if (!writeFile(path, QByteArray::fromStdString(resultsCsv(run_->metrics)))) {
+  return writeExport(path, resultsCsv(run_->metrics));
+}
+
+bool PlotWindow::exportFigureDataCsv(const QString& path) {
+  if (!run_ || tabs_->count() == 0) {
+    fail("no figure to export: select a run first");
+    return false;
+  }
+  return writeExport(
+      path, figureDataCsv(*run_, tabs_->tabText(tabs_->currentIndex()).toStdString(), hidden_));
+}
+
+bool PlotWindow::writeExport(const QString& path, const std::string& text) {
+  if (!writeFile(path, QByteArray::fromStdString(text))) {
     fail(path + ": cannot write the file");
     return false;
   }
@@ -743,13 +758,20 @@ void PlotWindow::chooseRoot() {
   if (!dir.isEmpty()) openRoot(dir);
 }
 
+QString PlotWindow::suggestedPath(const QString& name) const {
+  // Beside the run: in its folder, or in a log's.
+  const fs::path run(run_ ? run_->dir : root_.toStdString());
+  std::error_code error;
+  const fs::path folder = fs::is_directory(run, error) ? run : run.parent_path();
+  return QString::fromStdString((folder / name.toStdString()).string());
+}
+
 void PlotWindow::chooseFigureExport(const QString& suffix) {
   if (!run_) {
     fail("no figure to export: select a run first");
     return;
   }
-  const QString suggested = QDir(QString::fromStdString(run_->dir))
-                                .filePath(tabs_->tabText(tabs_->currentIndex()) + "." + suffix);
+  const QString suggested = suggestedPath(tabs_->tabText(tabs_->currentIndex()) + "." + suffix);
   const QString path = QFileDialog::getSaveFileName(this, "Export the figure", suggested,
                                                     suffix.toUpper() + " (*." + suffix + ")");
   if (!path.isEmpty()) exportFigure(path);
@@ -760,10 +782,20 @@ void PlotWindow::chooseTableExport() {
     fail("no table to export: select a run first");
     return;
   }
-  const QString suggested = QDir(QString::fromStdString(run_->dir)).filePath("results.csv");
-  const QString path =
-      QFileDialog::getSaveFileName(this, "Export the error table", suggested, "CSV (*.csv)");
+  const QString path = QFileDialog::getSaveFileName(this, "Export the error table",
+                                                    suggestedPath("results.csv"), "CSV (*.csv)");
   if (!path.isEmpty()) exportTableCsv(path);
+}
+
+void PlotWindow::chooseFigureDataExport() {
+  if (!run_) {
+    fail("no figure to export: select a run first");
+    return;
+  }
+  const QString path = QFileDialog::getSaveFileName(
+      this, "Export the figure's data",
+      suggestedPath(tabs_->tabText(tabs_->currentIndex()) + ".csv"), "CSV (*.csv)");
+  if (!path.isEmpty()) exportFigureDataCsv(path);
 }
 
 }  // namespace nadir::gui

@@ -78,6 +78,9 @@ class PlotWindow : public QMainWindow {
   bool exportFigure(const QString& path);
   // Writes the error table as resultsCsv does.
   bool exportTableCsv(const QString& path);
+  // Writes the data of the figure in the current tab as figureDataCsv does (the
+  // trajectories plotted, at full rate).
+  bool exportFigureDataCsv(const QString& path);
   // Every chart of every figure back to its initial ranges.
   void resetZoom();
 
@@ -109,6 +112,9 @@ class PlotWindow : public QMainWindow {
   void chooseRoot();
   void chooseFigureExport(const QString& suffix);
   void chooseTableExport();
+  void chooseFigureDataExport();
+  QString suggestedPath(const QString& name) const;
+  bool writeExport(const QString& path, const std::string& text);
 
   void addLiveItem();
   bool liveSelected() const;

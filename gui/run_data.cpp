@@ -345,4 +345,50 @@ std::string resultsCsv(const eval::RunMetrics& metrics) {
   return out;
 }
 
+std::string figureDataCsv(const RunData& run, const std::string& figure,
+                          const std::set<std::string>& hidden) {
+  using Field = const std::vector<double> PoseSeries::*;
+  std::vector<Field> fields;
+  std::string header;
+  if (figure == "position") {
+    fields = {&PoseSeries::x_m, &PoseSeries::y_m, &PoseSeries::z_m};
+    header = "north_m,east_m,down_m";
+  } else if (figure == "attitude") {
+    fields = {&PoseSeries::roll_deg, &PoseSeries::pitch_deg, &PoseSeries::yaw_deg};
+    header = "roll_deg,pitch_deg,yaw_deg";
+  } else if (figure == "top_view") {
+    fields = {&PoseSeries::x_m, &PoseSeries::y_m};
+    header = "north_m,east_m";
+  } else if (figure != "error") {
+    throw RunDataError("no figure " + figure + " (position, attitude, error, top_view)");
+  } else {
+    header = "position_error_m";
+  }
+  std::string out = "trajectory,time_s," + header + "\n";
+  const auto rows = [&](const std::string& name, const PoseSeries& pose,
+                        const std::vector<double>* error) {
+    if (hidden.contains(name)) return;
+    for (std::size_t i = 0; i < pose.size(); ++i) {
+      if (error != nullptr ? !std::isfinite((*error)[i]) : !std::isfinite(pose.x_m[i])) continue;
+      out += name;
+      out += ',';
+      appendNumber(out, pose.t_s[i] - run.t0_s);
+      if (error != nullptr) {
+        out += ',';
+        appendNumber(out, (*error)[i]);
+      }
+      for (const Field field : fields) {
+        out += ',';
+        appendNumber(out, (pose.*field)[i]);
+      }
+      out += '\n';
+    }
+  };
+  if (figure != "error") rows(run.truth_name, run.truth, nullptr);
+  for (const auto& [name, source] : run.sources) {
+    rows(name, source.pose, figure == "error" ? &source.position_error_m : nullptr);
+  }
+  return out;
+}
+
 }  // namespace nadir::gui

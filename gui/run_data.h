@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -131,5 +132,17 @@ RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recor
 // Numbers in the shortest text that reads back to the same double (the values of
 // metrics.json); a metric that does not exist is an empty field.
 std::string resultsCsv(const eval::RunMetrics& metrics);
+
+// The data behind a figure (position, attitude, error or top_view) as CSV, at
+// full rate: a header line, then a row per sample with a pose of each trajectory
+// plotted (the truth first, then the sources by name; those in `hidden` left
+// out), time in s since the truth's first pose:
+//   position  trajectory,time_s,north_m,east_m,down_m
+//   attitude  trajectory,time_s,roll_deg,pitch_deg,yaw_deg
+//   error     trajectory,time_s,position_error_m   (sources only)
+//   top_view  trajectory,time_s,north_m,east_m
+// Throws RunDataError for another figure name.
+std::string figureDataCsv(const RunData& run, const std::string& figure,
+                          const std::set<std::string>& hidden = {});
 
 }  // namespace nadir::gui

@@ -23,6 +23,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -319,7 +320,7 @@ TEST_F(GuiPlotWindow, WheelZoomsAndResetRestores) {
   EXPECT_NEAR(x_axis->max() - x_axis->min(), span, 1e-9 * span);
 }
 
-TEST_F(GuiPlotWindow, ExportsTheFigureAndTheTable) {
+TEST_F(GuiPlotWindow, ExportsTheFigureItsDataAndTheTable) {
   const fs::path root = makeRoot();
   const fs::path out = test::freshDir("window_out");
   PlotWindow window(QString::fromStdString(root.string()));
@@ -355,6 +356,16 @@ TEST_F(GuiPlotWindow, ExportsTheFigureAndTheTable) {
   std::ifstream csv_in(csv);
   const std::string csv_text((std::istreambuf_iterator<char>(csv_in)), {});
   EXPECT_EQ(csv_text, resultsCsv(window.run()->metrics));
+
+  // The top view's data: the truth's 101 samples and vo_test's 19, north and east.
+  const fs::path data = out / "top_view.csv";
+  ASSERT_TRUE(window.exportFigureDataCsv(QString::fromStdString(data.string())));
+  std::ifstream data_in(data);
+  const std::string data_text((std::istreambuf_iterator<char>(data_in)), {});
+  EXPECT_EQ(data_text.rfind("trajectory,time_s,north_m,east_m\ntruth,0,0,0\n", 0), 0u)
+      << data_text.substr(0, 200);
+  EXPECT_NE(data_text.find("\nvo_test,0.5,8,6.5\n"), std::string::npos);
+  EXPECT_EQ(std::count(data_text.begin(), data_text.end(), '\n'), 1 + 101 + 19);
 
   EXPECT_FALSE(window.exportTableCsv(QString::fromStdString((out / "no" / "x.csv").string())));
   EXPECT_FALSE(window.lastError().isEmpty());

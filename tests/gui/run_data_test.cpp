@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -250,6 +251,27 @@ TEST(GuiRunData, RefusesForeignAndMissingFiles) {
   writeText(text, "not a log either\n");
   message = loadError(text);
   EXPECT_NE(message.find("notes.lcmlog"), std::string::npos) << message;
+}
+
+// Rows worked out from the tiny run: the truth at 10 m/s north, 5 m/s east,
+// 100 m up from t = 0; vo_test (3, 4, 0) m off it from t = 0.5 s, every 0.5 s.
+TEST(GuiRunData, FigureDataAtFullRate) {
+  const RunData run = loadRun(test::writeTumRun("figure_data").string());
+  const std::string position = figureDataCsv(run, "position");
+  EXPECT_EQ(position.rfind("trajectory,time_s,north_m,east_m,down_m\ntruth,0,0,0,-100\n", 0), 0u)
+      << position.substr(0, 200);
+  EXPECT_NE(position.find("\ntruth,10,100,50,-100\n"), std::string::npos);
+  EXPECT_NE(position.find("\nvo_test,0.5,8,6.5,-100\n"), std::string::npos);
+  EXPECT_EQ(std::count(position.begin(), position.end(), '\n'), 1 + kTruthPoses + kEstimates);
+
+  const std::string error = figureDataCsv(run, "error");
+  EXPECT_EQ(error.rfind("trajectory,time_s,position_error_m\nvo_test,0.5,5", 0), 0u) << error;
+  EXPECT_EQ(std::count(error.begin(), error.end(), '\n'), 1 + kEstimates);
+
+  const std::string attitude = figureDataCsv(run, "attitude", {"truth"});
+  EXPECT_EQ(attitude.find("\ntruth,"), std::string::npos);
+  EXPECT_EQ(std::count(attitude.begin(), attitude.end(), '\n'), 1 + kEstimates);
+  EXPECT_THROW(figureDataCsv(run, "sideways"), RunDataError);
 }
 
 // vo_test as the truth: the recorded truth becomes a source, 5 m from it wherever
