@@ -44,6 +44,14 @@ QString truthLabel(const RunData& run) {
   return QString::fromStdString(run.truth_name) + QStringLiteral(" (truth)");
 }
 
+QString sourceLabel(const RunData& run, const std::string& name) {
+  // The recorded truth compared with another is not the truth of these charts.
+  if (name == kRecordedTruthName && name != run.truth_name) {
+    return QStringLiteral("truth (recorded)");
+  }
+  return QString::fromStdString(name);
+}
+
 namespace {
 
 // Enough points for a 1200 px wide chart; more only slow the drawing down.
@@ -212,7 +220,7 @@ Figure timeFigure(const RunData& run, const HiddenTrajectories& hidden, const st
     for (const auto& [source, series] : run.sources) {
       if (hidden.contains(source)) continue;
       const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
-      chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
+      chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
                     series.pose.*field, angles);
     }
     figure.charts.push_back(chart.take());
@@ -337,7 +345,7 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
   for (const auto& [source, series] : run.sources) {
     if (hidden.contains(source)) continue;
     const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
-    chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, t,
+    chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
                   series.position_error_m);
   }
   std::unique_ptr<QChart> built = chart.take();
@@ -359,7 +367,7 @@ Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden) {
   for (const auto& [source, series] : run.sources) {
     if (hidden.contains(source)) continue;
     const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
-    chart.addLine(QString::fromStdString(source), sourceColor(run, source), 1.5, t, series.pose.y_m,
+    chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, series.pose.y_m,
                   series.pose.x_m);
   }
   const Range x = chart.xRange();

@@ -25,6 +25,9 @@ QColor sourceColor(const RunData& run, const std::string& name);
 // The truth's legend entry: "truth", or "NAME (truth)" when another trajectory
 // than the recorded truth was chosen.
 QString truthLabel(const RunData& run);
+// A source's legend entry: its name, "truth (recorded)" for the recorded truth
+// when another trajectory is the truth.
+QString sourceLabel(const RunData& run, const std::string& name);
 
 // Trajectories left out of the figures, by name (the truth's included).
 using HiddenTrajectories = std::set<std::string>;

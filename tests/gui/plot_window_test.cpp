@@ -204,7 +204,7 @@ TEST_F(GuiPlotWindow, ChoosingTheTruthRecomputesFiguresAndTable) {
       << window.tableCaption()->text().toStdString();
   const std::set<QString> names = seriesNames(window.figureTabs()->widget(0));
   EXPECT_TRUE(names.contains("vo_test (truth)"));
-  EXPECT_TRUE(names.contains("truth"));
+  EXPECT_TRUE(names.contains("truth (recorded)"));
 
   ASSERT_TRUE(window.selectRun("computed"));
   EXPECT_EQ(window.truthName(), "vo_test");
