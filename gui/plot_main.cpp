@@ -12,7 +12,6 @@
 #include <CLI/CLI.hpp>
 
 #include <QApplication>
-#include <QTimer>
 
 #include <cstdio>
 #include <cstdlib>
@@ -28,6 +27,7 @@
 #include "gui/plot_window.h"
 #include "gui/plots.h"
 #include "gui/run_data.h"
+#include "gui/screenshot.h"
 
 namespace {
 
@@ -138,17 +138,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     window.show();
-    if (!screenshot.empty()) {
-      // After the charts have laid themselves out in the shown window.
-      QTimer::singleShot(static_cast<int>(wait_s * 1000), &window, [&window, &screenshot] {
-        if (!window.grab().save(QString::fromStdString(screenshot))) {
-          std::fprintf(stderr, "nadir-plot: cannot write %s\n", screenshot.c_str());
-          QApplication::exit(1);
-          return;
-        }
-        QApplication::exit(0);
-      });
-    }
+    // After the charts have laid themselves out in the shown window.
+    if (!screenshot.empty()) nadir::gui::screenshotAfter(window, wait_s, screenshot, "nadir-plot");
     return QApplication::exec();
   }
   if (!select.empty() || !figure.empty() || !screenshot.empty()) {

@@ -8,7 +8,6 @@
 #include <CLI/CLI.hpp>
 
 #include <QApplication>
-#include <QTimer>
 
 #include <cstdint>
 #include <cstdio>
@@ -21,6 +20,7 @@
 #include "core/bus.h"
 #include "gui/live_feed.h"
 #include "gui/run_data.h"
+#include "gui/screenshot.h"
 #include "gui/trajectory_view.h"
 #include "gui/viewer_window.h"
 
@@ -99,13 +99,8 @@ int main(int argc, char** argv) {
   window.show();
   if (!live) window.seek(at_s);
   if (!screenshot.empty()) {
-    QTimer::singleShot(static_cast<int>(wait_s * 1000), &window, [&window, &screenshot] {
-      if (!window.grab().save(QString::fromStdString(screenshot))) {
-        std::fprintf(stderr, "nadir-viewer: cannot write %s\n", screenshot.c_str());
-        QApplication::exit(1);
-        return;
-      }
-      // What was shown, for scripts: each run's poses, the time and the image.
+    // What was shown, for scripts: each run's poses, the time and the image.
+    nadir::gui::screenshotAfter(window, wait_s, screenshot, "nadir-viewer", [&window] {
       for (const nadir::gui::RunData& run : window.runs()) {
         std::printf("run %s: %zu truth poses", run.dir.c_str(), run.truth.size());
         for (const auto& [name, source] : run.sources) {
@@ -115,7 +110,6 @@ int main(int argc, char** argv) {
       }
       std::printf("time %s\ncamera %s\n", window.timeText().toStdString().c_str(),
                   window.cameraCaption().toStdString().c_str());
-      QApplication::exit(0);
     });
   }
   return QApplication::exec();
