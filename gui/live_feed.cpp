@@ -50,19 +50,10 @@ void LiveFeed::restart() {
 
 int LiveFeed::poll() { return bus_.handleAvailable(); }
 
-std::optional<RunData> LiveFeed::run(const std::string& name, std::string* metrics_error) const {
+std::optional<RunData> LiveFeed::run(const std::string& name) const {
   if (collector_.truthPoses() == 0) return std::nullopt;
-  const eval::LogTrajectories recorded = collector_.trajectories();
-  RunData run = runFromPoses(name, recorded);
+  RunData run = runFromPoses(name, collector_.trajectories());
   run.poses_from = "the bus";
-  if (metrics_error != nullptr) {
-    metrics_error->clear();
-    try {
-      run.metrics = eval::evaluate(recorded.truth, recorded.sources, run.options);
-    } catch (const eval::EvalError& e) {
-      *metrics_error = e.what();
-    }
-  }
   return run;
 }
 

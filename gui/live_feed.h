@@ -44,10 +44,10 @@ class LiveFeed {
   // A truth stamped more than kRestartJump_s before the newest one starts a new
   // run: what was gathered is dropped (a simulation started again).
   std::uint64_t version() const { return version_; }
-  // The run so far, named `name` (RunData::dir); nothing before the first truth
-  // pose. The metrics are computed only when metrics_error is given (they cost
-  // more than the series); it says why they could not be, else it is cleared.
-  std::optional<RunData> run(const std::string& name, std::string* metrics_error = nullptr) const;
+  // The run so far, named `name` (RunData::dir), without its metrics (they cost
+  // more than the series: computeMetrics gives them); nothing before the first
+  // truth pose.
+  std::optional<RunData> run(const std::string& name) const;
   CameraFrames* frames() { return frames_.get(); }
   // How many times a new run replaced the gathered one.
   int restarts() const { return restarts_; }

@@ -175,17 +175,17 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
   return fields;
 }
 
-// The run against another truth, with its metrics if they can be computed (a live
-// truth may be too short yet); if not, why in metrics_error. Throws RunDataError
-// for a trajectory the run does not have or that has no pose.
-RunData againstTruth(const RunData& run, const std::string& truth, std::string& metrics_error) {
+// Puts run against truth (its own or another of its trajectories), with its
+// metrics if they can be computed (a live truth may be too short yet); if not, why
+// in metrics_error. Throws RunDataError, run unchanged, for a trajectory the run
+// does not have or that has no pose.
+void compareAgainst(RunData& run, const std::string& truth, std::string& metrics_error) {
+  if (truth != run.truth_name) run = compareWithTruth(run, truth, false);
   metrics_error.clear();
   try {
-    return compareWithTruth(run, truth, true);
+    computeMetrics(run);
   } catch (const RunDataError& error) {
-    RunData without_metrics = compareWithTruth(run, truth, false);
     metrics_error = error.what();
-    return without_metrics;
   }
 }
 
@@ -407,7 +407,7 @@ bool PlotWindow::chooseTruth(const QString& name) {
     return false;
   }
   try {
-    run_ = againstTruth(*run_, name.toStdString(), metrics_note_);
+    compareAgainst(*run_, name.toStdString(), metrics_note_);
   } catch (const std::exception& error) {
     fail(QString::fromStdString(error.what()));
     showTrajectories();  // the box back on the truth that stands
@@ -444,15 +444,18 @@ void PlotWindow::setTrajectoryShown(const QString& name, bool shown) {
   if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
 }
 
-bool PlotWindow::applyPreferredTruth() {
-  if (!run_ || preferred_truth_.isEmpty()) return true;
+std::string PlotWindow::truthFor(const RunData& run) const {
   const std::string wanted = preferred_truth_.toStdString();
-  const std::vector<std::string> names = trajectoryNames(*run_);
-  if (run_->truth_name == wanted || std::find(names.begin(), names.end(), wanted) == names.end()) {
-    return true;
-  }
+  const std::vector<std::string> names = trajectoryNames(run);
+  const bool has = std::find(names.begin(), names.end(), wanted) != names.end();
+  return !wanted.empty() && has ? wanted : run.truth_name;
+}
+
+bool PlotWindow::applyPreferredTruth() {
+  const std::string truth = truthFor(*run_);
+  if (truth == run_->truth_name) return true;
   try {
-    run_ = againstTruth(*run_, wanted, metrics_note_);
+    compareAgainst(*run_, truth, metrics_note_);
   } catch (const std::exception& error) {
     fail(QString::fromStdString(error.what()));
     return false;
@@ -513,21 +516,34 @@ void PlotWindow::refreshLive() {
   shown_version_ = feed_->version();
   const int tab = tabs_->currentIndex();
   clearRun();
+  std::optional<RunData> live;
   try {
-    run_ = feed_->run("live", &metrics_note_);
+    live = feed_->run("live");
   } catch (const std::exception& error) {
     fail(QString::fromStdString(error.what()));
     return;
   }
-  if (!run_) {
+  if (!live) {
     fail(QStringLiteral("live: waiting for the truth on %1").arg(eval::kTruthChannel));
     return;
   }
-  const bool compared = applyPreferredTruth();
+  // The metrics once, against the truth shown.
+  run_ = std::move(live);
+  bool compared = true;
+  try {
+    compareAgainst(*run_, truthFor(*run_), metrics_note_);
+  } catch (const std::exception& error) {
+    compared = false;
+    fail(QString::fromStdString(error.what()));
+    compareAgainst(*run_, run_->truth_name, metrics_note_);
+  }
   if (compared) last_error_.clear();
   showRun();
   if (tab >= 0 && tab < tabs_->count()) tabs_->setCurrentIndex(tab);
-  if (!compared) return;  // its error stays in the status bar
+  if (!compared) {
+    statusBar()->showMessage(last_error_);  // showRun wrote over it
+    return;
+  }
   QString status = QStringLiteral("live: %1 truth poses").arg(run_->truth.size());
   for (const auto& [name, source] : run_->sources) {
     status += QStringLiteral(", %1 %2 estimates")

@@ -99,8 +99,10 @@ class PlotWindow : public QMainWindow {
 
  private:
   void loadRunAt(const QString& dir);
-  // The preferred truth applied to run_ if it has it; false (error shown) if
-  // that fails, run_ then kept against its recorded truth.
+  // The truth run is shown against: the preferred one if it has it, else its own.
+  std::string truthFor(const RunData& run) const;
+  // A loaded run_ against truthFor(run_); false (error shown) if that fails,
+  // run_ then kept against its recorded truth.
   bool applyPreferredTruth();
   void showRun();
   void removeFigures();

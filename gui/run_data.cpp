@@ -150,16 +150,44 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
+std::vector<std::string> namesOf(const RunTrajectories& read) {
+  std::vector<std::string> names = {read.recorded_truth};
+  for (const auto& [name, estimates] : read.by_name) {
+    if (name != read.recorded_truth) names.push_back(name);
+  }
+  return names;
+}
+
+// The run's metrics against truth, its truth's poses as truthOf gives them.
+void setMetrics(RunData& run, const eval::PoseTrajectory& truth) {
+  const RunTrajectories& read = *run.trajectories;
+  run.metrics = {};
+  run.metrics_from.clear();
+  if (run.truth_name == kRecordedTruthName && read.recorded_metrics) {
+    run.metrics = *read.recorded_metrics;
+    run.metrics_from = read.metrics_file;
+    return;
+  }
+  std::map<std::string, std::vector<eval::SourceEstimate>> others;
+  for (const auto& [name, estimates] : read.by_name) {
+    if (name != run.truth_name) others.emplace(name, estimates);
+  }
+  try {
+    run.metrics = eval::evaluate(truth, others, read.options);
+  } catch (const eval::EvalError& e) {
+    throw RunDataError(run.poses_from + ": cannot evaluate against " + run.truth_name + ": " +
+                       e.what());
+  }
+}
+
 // Builds the series and metrics of a run against one of its trajectories.
 RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> read,
                  std::string poses_from, std::string damage, const std::string& truth_name,
                  bool compute_metrics) {
   const auto chosen = read->by_name.find(truth_name);
   if (chosen == read->by_name.end()) {
-    RunData named;
-    named.trajectories = read;
     throw RunDataError(dir + ": no trajectory " + truth_name + " (it has " +
-                       joined(trajectoryNames(named)) + ")");
+                       joined(namesOf(*read)) + ")");
   }
   const eval::PoseTrajectory truth = truthOf(chosen->second);
   if (truth.empty()) throw RunDataError(dir + ": " + truth_name + " has no tracked pose");
@@ -172,24 +200,12 @@ RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> 
   run.options = read->options;
   run.t0_s = truth.front().t_s;
   for (const eval::StampedPose& pose : truth) appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
-  std::map<std::string, std::vector<eval::SourceEstimate>> others;
   for (const auto& [name, estimates] : read->by_name) {
     if (name == truth_name) continue;
     run.sources[name] = sourceSeries(truth, estimates, read->options.truth_max_gap_s);
-    if (compute_metrics) others.emplace(name, estimates);
-  }
-  if (truth_name == kRecordedTruthName && read->recorded_metrics) {
-    run.metrics = *read->recorded_metrics;
-    run.metrics_from = read->metrics_file;
-  } else if (compute_metrics) {
-    try {
-      run.metrics = eval::evaluate(truth, others, read->options);
-    } catch (const eval::EvalError& e) {
-      throw RunDataError(run.poses_from + ": cannot evaluate against " + truth_name + ": " +
-                         e.what());
-    }
   }
   run.trajectories = std::move(read);
+  if (compute_metrics) setMetrics(run, truth);
   return run;
 }
 
@@ -213,23 +229,18 @@ void appendNumber(std::string& out, double value) {
 }  // namespace
 
 std::vector<std::string> trajectoryNames(const RunData& run) {
-  std::vector<std::string> names;
-  if (!run.trajectories) {
-    names.push_back(run.truth_name);
-    for (const auto& [name, series] : run.sources) names.push_back(name);
-    return names;
-  }
-  names.push_back(run.trajectories->recorded_truth);
-  for (const auto& [name, estimates] : run.trajectories->by_name) {
-    if (name != run.trajectories->recorded_truth) names.push_back(name);
-  }
-  return names;
+  return run.trajectories ? namesOf(*run.trajectories) : std::vector<std::string>{};
 }
 
 RunData compareWithTruth(const RunData& run, const std::string& truth_name, bool compute_metrics) {
   if (!run.trajectories) throw RunDataError(run.dir + ": the run holds no trajectories");
   return buildRun(run.dir, run.trajectories, run.poses_from, run.damage, truth_name,
                   compute_metrics);
+}
+
+void computeMetrics(RunData& run) {
+  if (!run.trajectories) throw RunDataError(run.dir + ": the run holds no trajectories");
+  setMetrics(run, truthOf(run.trajectories->by_name.at(run.truth_name)));
 }
 
 bool isRunDir(const std::string& dir) {

@@ -102,6 +102,12 @@ std::vector<std::string> trajectoryNames(const RunData& run);
 RunData compareWithTruth(const RunData& run, const std::string& truth_name,
                          bool compute_metrics = true);
 
+// Sets the run's metrics against its truth: metrics.json's when the truth is the
+// recorded one and the run has them, else computed from its trajectories with its
+// options. Throws RunDataError naming the run if they cannot be (a truth of one
+// pose), the run then left without metrics.
+void computeMetrics(RunData& run);
+
 // True if dir holds run.lcmlog, metrics.json or a TUM file (*.tum).
 bool isRunDir(const std::string& dir);
 

@@ -16,7 +16,6 @@
 
 #include "core/bus.h"
 #include "core/clock.h"
-#include "core/params.h"
 #include "nadir/vo_estimate_t.hpp"
 #include "nodes/sim/simulator.h"
 #include "run/process.h"
@@ -87,11 +86,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
                              "--out or pass --force to replace it");
   }
   fs::create_directories(out_path);
-  // The effective scenario beside the recording, as nadir run writes it: the
-  // viewers take its terrain, and it says what ran.
-  std::ofstream(out_path / "scenario.yaml")
-      << "# nadir launch " << options.scenario << ": the effective scenario\n"
-      << core::formatParamsOf(scenario);
+  writeEffectiveScenario(out_dir, "nadir launch " + options.scenario, scenario);
   const std::string bin_dir = options.bin_dir.empty() ? selfDirectory() : options.bin_dir;
   const std::string url = scenario.bus.resolvedUrl();
 

@@ -65,9 +65,7 @@ RunResult runScenario(const RunOptions& options,
   fs::create_directories(out);
   result.log_path = (out / kLogName).string();
   result.metrics_path = (out / kMetricsName).string();
-  std::ofstream(out / kScenarioName)
-      << "# nadir run " << options.scenario << ": the effective scenario\n"
-      << core::formatParamsOf(scenario);
+  writeEffectiveScenario(result.out_dir, "nadir run " + options.scenario, scenario);
 
   auto bus = core::openBus(scenario.bus);
   core::LcmLogWriter log(result.log_path);
@@ -169,6 +167,12 @@ RunResult runScenario(const RunOptions& options,
     std::ofstream(out / "target_passes.csv") << targetPassesCsv(result.target_passes);
   }
   return result;
+}
+
+void writeEffectiveScenario(const std::string& dir, const std::string& command,
+                            scenario::ScenarioParams& scenario) {
+  std::ofstream(fs::path(dir) / kScenarioName) << "# " << command << ": the effective scenario\n"
+                                               << core::formatParamsOf(scenario);
 }
 
 RunPlots renderRunPlots(const std::string& run, const std::string& plots_dir,

@@ -13,6 +13,10 @@
 #include "eval/run_metrics.h"
 #include "run/target_passes.h"
 
+namespace nadir::scenario {
+struct ScenarioParams;
+}
+
 namespace nadir::run {
 
 struct RunOptions {
@@ -57,6 +61,11 @@ struct RunResult {
 // run and force is not set.
 RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress = {});
+
+// Writes dir/scenario.yaml: the scenario as it ran, under "# <command>: the
+// effective scenario" (nadir run and nadir launch; the viewers take its terrain).
+void writeEffectiveScenario(const std::string& dir, const std::string& command,
+                            scenario::ScenarioParams& scenario);
 
 struct RunPlots {
   std::vector<std::string> png_paths;  // what nadir-plot wrote into the plots folder
