@@ -22,8 +22,8 @@
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/target_extraction.h"
 #include "nodes/ppa/visual_odometry.h"
-// The synthetic scenes the ppa tests use.
-#include "tests/ppa/ppa_scenes.h"
+// The synthetic scenes (shared with the ppa tests).
+#include "bench/ppa_scenes.h"
 
 namespace {
 

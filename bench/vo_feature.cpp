@@ -29,11 +29,11 @@
 
 #include "core/bus.h"
 #include "core/lcm_log.h"
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 #include "nadir/image_t.hpp"
 #include "nodes/camera/camera_messages.h"
 #include "nodes/vo_feature/vo_feature_node.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 
 namespace {
 

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "eval/metrics.h"
-#include "eval/run_metrics.h"
-#include "eval/trajectory.h"
+#include "logs/eval/metrics.h"
+#include "logs/eval/run_metrics.h"
+#include "logs/eval/trajectory.h"
 
 namespace nadir::cli {
 namespace {

@@ -11,7 +11,7 @@
 
 #include <unistd.h>
 
-#include "dataset/export.h"
+#include "logs/export/export.h"
 
 namespace nadir::cli {
 namespace {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/bus.h"
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 #include "gui/camera_frames.h"
 #include "gui/run_data.h"
 

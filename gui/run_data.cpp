@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "core/frames.h"
-#include "eval/trajectory.h"
+#include "logs/eval/trajectory.h"
 
 namespace nadir::gui {
 namespace {

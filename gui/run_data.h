@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 
 namespace nadir::gui {
 

@@ -18,7 +18,7 @@
 
 #include "core/params.h"
 #include "gui/plots.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 
 namespace nadir::gui {
 namespace {

@@ -20,7 +20,7 @@
 #include "nodes/sim/simulator.h"
 #include "run/process.h"
 #include "run/run.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 #include "terrain/world_factory.h"
 
 namespace nadir::run {

@@ -13,7 +13,7 @@
 #include "core/bus.h"
 #include "core/clock.h"
 #include "core/lcm_log.h"
-#include "eval/trajectory.h"
+#include "logs/eval/trajectory.h"
 #include "nadir/target_detection_t.hpp"
 #include "nodes/camera/camera_messages.h"
 #include "nodes/camera/camera_node.h"
@@ -24,7 +24,7 @@
 #include "run/process.h"
 #include "run/target_passes.h"
 #include "run/track_plot.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 #include "terrain/world.h"
 
 #include <opencv2/imgcodecs.hpp>

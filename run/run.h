@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 #include "run/target_passes.h"
 
 namespace nadir::scenario {

@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 
 namespace nadir::run {
 

@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 
 namespace nadir::run {
 

@@ -5,7 +5,7 @@
 #include <map>
 #include <string>
 
-#include "eval/trajectory.h"
+#include "logs/eval/trajectory.h"
 
 namespace nadir::run {
 

@@ -13,7 +13,7 @@
 #include "core/bus.h"
 #include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_node.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 
 namespace {
 

@@ -17,7 +17,7 @@
 #include "core/clock.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 #include "terrain/world_factory.h"
 
 namespace {

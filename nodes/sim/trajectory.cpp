@@ -9,7 +9,7 @@
 
 #include "core/clock.h"
 #include "core/frames.h"
-#include "eval/trajectory.h"
+#include "logs/eval/trajectory.h"
 
 namespace nadir::sim {
 namespace {

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "nodes/vo_feature/vo_feature_node.h"
-#include "scenario/node_main.h"
+#include "nodes/node_main.h"
 
 int main(int argc, char** argv) {
   nadir::scenario::ScenarioNodeSpec spec;

@@ -18,8 +18,8 @@
 #include "core/bus.h"
 #include "core/frames.h"
 #include "core/lcm_log.h"
-#include "eval/run_metrics.h"
-#include "eval/trajectory.h"
+#include "logs/eval/run_metrics.h"
+#include "logs/eval/trajectory.h"
 #include "nadir/pose_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
 

@@ -14,11 +14,11 @@
 
 #include "core/bus.h"
 #include "core/lcm_log.h"
-#include "eval/run_metrics.h"
+#include "logs/eval/run_metrics.h"
 #include "run/launch.h"
 #include "run/run.h"
 #include "run/sweep.h"
-#include "scenario/scenario.h"
+#include "nodes/scenario.h"
 
 namespace nadir::run {
 namespace {

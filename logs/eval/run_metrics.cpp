@@ -1,0 +1,575 @@
+#include "logs/eval/run_metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+
+#include "core/bus.h"
+#include "core/frames.h"
+#include "core/lcm_log.h"
+#include "nadir/pose_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+
+namespace nadir::eval {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+void appendNote(std::string& notes, const std::string& note) {
+  if (!notes.empty()) notes += "; ";
+  notes += note;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  std::sort(values.begin(), values.end());
+  const std::size_t middle = values.size() / 2;
+  return values.size() % 2 == 1 ? values[middle] : 0.5 * (values[middle - 1] + values[middle]);
+}
+
+double percentOf(double value, double whole) {
+  if (!std::isfinite(value) || !(whole > 0)) return kNaN;
+  return 100.0 * value / whole;
+}
+
+// Time during which the (sorted) estimates say TRACKING, clipped to [t0, t1].
+double trackedTime(const std::vector<SourceEstimate>& estimates, double t0, double t1,
+                   double hold_periods) {
+  std::vector<double> intervals;
+  for (std::size_t k = 1; k < estimates.size(); ++k) {
+    const double dt = estimates[k].t_s - estimates[k - 1].t_s;
+    if (dt > 0) intervals.push_back(dt);
+  }
+  if (intervals.empty()) return 0;
+  const double period = median(intervals);
+  const double max_hold = hold_periods * period;
+  double tracked = 0;
+  for (std::size_t k = 0; k < estimates.size(); ++k) {
+    if (estimates[k].status != SourceEstimate::kTracking) continue;
+    const double start = estimates[k].t_s;
+    const double hold = k + 1 < estimates.size() ? estimates[k + 1].t_s - start : period;
+    const double end = start + std::min(hold, max_hold);
+    tracked += std::max(0.0, std::min(end, t1) - std::max(start, t0));
+  }
+  return tracked;
+}
+
+// --------------------------------------------------------------- metrics.json
+
+Json number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+
+Json statisticsJson(const Statistics& s) {
+  return Json{{"rmse", number(s.rmse)}, {"mean", number(s.mean)}, {"median", number(s.median)},
+              {"std", number(s.std)},   {"min", number(s.min)},   {"max", number(s.max)},
+              {"count", s.count}};
+}
+
+Json sourceJson(const SourceMetrics& m) {
+  Json j;
+  j["initialised"] = m.initialised;
+  j["position_rmse_m"] = number(m.position_rmse_m);
+  j["rotation_rmse_deg"] = number(m.rotation_rmse_deg);
+  j["tracked_pct"] = number(m.tracked_pct);
+  j["track_length_m"] = number(m.track_length_m);
+  j["truth_track_length_m"] = number(m.truth_track_length_m);
+  j["track_length_diff_pct"] = number(m.track_length_diff_pct);
+  j["mean_abs_error_m"] = number(m.mean_abs_error_m);
+  j["end_point_m"] = number(m.end_point_m);
+  j["end_point_pct"] = number(m.end_point_pct);
+  j["rate_hz"] = number(m.rate_hz);
+  j["first_tracking_s"] = number(m.first_tracking_s);
+  j["estimates"] = m.estimates;
+  j["estimates_tracking"] = m.estimates_tracking;
+  j["estimates_evaluated"] = m.estimates_evaluated;
+  j["tracking_segments"] = m.tracking_segments;
+  j["ape"] = Json{{"alignment", m.alignment},
+                  {"scale", number(m.alignment_scale)},
+                  {"translation_m", statisticsJson(m.ape_translation_m)},
+                  {"rotation_deg", statisticsJson(m.ape_rotation_deg)}};
+  j["rpe"] = Json{{"delta", m.rpe_delta},
+                  {"delta_unit", m.rpe_delta_unit},
+                  {"translation_m", statisticsJson(m.rpe_translation_m)},
+                  {"rotation_deg", statisticsJson(m.rpe_rotation_deg)}};
+  j["note"] = m.note;
+  return j;
+}
+
+// Reading: every lookup names the key path and the file when it fails.
+class JsonReader {
+ public:
+  explicit JsonReader(std::string path) : path_(std::move(path)) {}
+
+  const Json& at(const Json& object, const std::string& key, const std::string& where) const {
+    if (!object.is_object()) fail(where, "is not an object");
+    const auto it = object.find(key);
+    if (it == object.end()) fail(where, "missing key '" + key + "'");
+    return *it;
+  }
+  double number(const Json& object, const std::string& key, const std::string& where) const {
+    const Json& value = at(object, key, where);
+    if (value.is_null()) return kNaN;
+    if (!value.is_number()) fail(where + "." + key, "is not a number");
+    return value.get<double>();
+  }
+  std::size_t count(const Json& object, const std::string& key, const std::string& where) const {
+    const Json& value = at(object, key, where);
+    if (!value.is_number_unsigned()) fail(where + "." + key, "is not a count");
+    return value.get<std::size_t>();
+  }
+  std::string text(const Json& object, const std::string& key, const std::string& where) const {
+    const Json& value = at(object, key, where);
+    if (!value.is_string()) fail(where + "." + key, "is not a string");
+    return value.get<std::string>();
+  }
+  bool flag(const Json& object, const std::string& key, const std::string& where) const {
+    const Json& value = at(object, key, where);
+    if (!value.is_boolean()) fail(where + "." + key, "is not true or false");
+    return value.get<bool>();
+  }
+  Statistics statistics(const Json& object, const std::string& key,
+                        const std::string& where) const {
+    const Json& s = at(object, key, where);
+    const std::string here = where + "." + key;
+    Statistics out;
+    out.rmse = number(s, "rmse", here);
+    out.mean = number(s, "mean", here);
+    out.median = number(s, "median", here);
+    out.std = number(s, "std", here);
+    out.min = number(s, "min", here);
+    out.max = number(s, "max", here);
+    out.count = count(s, "count", here);
+    return out;
+  }
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw EvalError(path_ + ": " + where + ": " + what);
+  }
+
+ private:
+  std::string path_;
+};
+
+SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::string& where) {
+  SourceMetrics m;
+  m.initialised = r.flag(j, "initialised", where);
+  m.position_rmse_m = r.number(j, "position_rmse_m", where);
+  m.rotation_rmse_deg = r.number(j, "rotation_rmse_deg", where);
+  m.tracked_pct = r.number(j, "tracked_pct", where);
+  m.track_length_m = r.number(j, "track_length_m", where);
+  m.truth_track_length_m = r.number(j, "truth_track_length_m", where);
+  m.track_length_diff_pct = r.number(j, "track_length_diff_pct", where);
+  m.mean_abs_error_m = r.number(j, "mean_abs_error_m", where);
+  m.end_point_m = r.number(j, "end_point_m", where);
+  m.end_point_pct = r.number(j, "end_point_pct", where);
+  m.rate_hz = r.number(j, "rate_hz", where);
+  m.first_tracking_s = r.number(j, "first_tracking_s", where);
+  m.estimates = r.count(j, "estimates", where);
+  m.estimates_tracking = r.count(j, "estimates_tracking", where);
+  m.estimates_evaluated = r.count(j, "estimates_evaluated", where);
+  m.tracking_segments = r.count(j, "tracking_segments", where);
+  const Json& ape = r.at(j, "ape", where);
+  m.alignment = r.text(ape, "alignment", where + ".ape");
+  m.alignment_scale = r.number(ape, "scale", where + ".ape");
+  m.ape_translation_m = r.statistics(ape, "translation_m", where + ".ape");
+  m.ape_rotation_deg = r.statistics(ape, "rotation_deg", where + ".ape");
+  const Json& rpe = r.at(j, "rpe", where);
+  m.rpe_delta = r.number(rpe, "delta", where + ".rpe");
+  m.rpe_delta_unit = r.text(rpe, "delta_unit", where + ".rpe");
+  m.rpe_translation_m = r.statistics(rpe, "translation_m", where + ".rpe");
+  m.rpe_rotation_deg = r.statistics(rpe, "rotation_deg", where + ".rpe");
+  m.note = r.text(j, "note", where);
+  return m;
+}
+
+// ------------------------------------------------------------------ the table
+
+std::string cell(double value, int decimals) {
+  if (!std::isfinite(value)) return "-";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+}  // namespace
+
+SourceMetrics evaluateSource(const PoseTrajectory& truth,
+                             const std::vector<SourceEstimate>& estimates,
+                             const EvalOptions& options) {
+  validateOptions(options);
+  if (truth.size() < 2 || !(truth.back().t_s > truth.front().t_s)) {
+    throw EvalError("the truth has " + std::to_string(truth.size()) +
+                    " poses over no time; need at least 2 poses spanning a time");
+  }
+  std::vector<SourceEstimate> sorted = estimates;
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [](const SourceEstimate& a, const SourceEstimate& b) { return a.t_s < b.t_s; });
+  const double t0 = truth.front().t_s;
+  const double t1 = truth.back().t_s;
+
+  SourceMetrics m;
+  m.alignment = alignModeName(parseAlignMode(options.align));
+  m.rpe_delta = options.rpe_delta;
+  m.rpe_delta_unit = options.rpe_delta_unit;
+  m.estimates = sorted.size();
+  if (sorted.size() >= 2 && sorted.back().t_s > sorted.front().t_s) {
+    m.rate_hz = static_cast<double>(sorted.size() - 1) / (sorted.back().t_s - sorted.front().t_s);
+  }
+  m.tracked_pct = 100.0 * trackedTime(sorted, t0, t1, options.tracked_hold_periods) / (t1 - t0);
+
+  // Evaluated pairs, with the tracking segment each belongs to.
+  PoseTrajectory ref;
+  PoseTrajectory est;
+  std::vector<std::size_t> segment_of;
+  bool in_segment = false;
+  std::size_t outside_truth = 0;
+  for (const SourceEstimate& e : sorted) {
+    if (e.status != SourceEstimate::kTracking) {
+      in_segment = false;
+      continue;
+    }
+    if (!in_segment) ++m.tracking_segments;
+    in_segment = true;
+    if (m.estimates_tracking++ == 0) m.first_tracking_s = e.t_s - t0;
+    const std::optional<StampedPose> truth_here =
+        interpolate(truth, e.t_s, options.truth_max_gap_s);
+    if (!truth_here) {
+      ++outside_truth;
+      continue;
+    }
+    ref.push_back(*truth_here);
+    est.push_back(StampedPose{e.t_s, e.p_m, e.q.normalized()});
+    segment_of.push_back(m.tracking_segments);
+  }
+  m.initialised = m.estimates_tracking > 0;
+  m.estimates_evaluated = ref.size();
+  if (outside_truth > 0) {
+    appendNote(m.note, std::to_string(outside_truth) +
+                           " TRACKING estimates outside the truth's time span or over a hole in "
+                           "it were not compared");
+  }
+  if (!m.initialised) {
+    appendNote(m.note, m.estimates == 0 ? "no estimates" : "never tracked");
+    return m;
+  }
+  if (ref.empty()) return m;
+
+  m.position_rmse_m = thesisPositionRmse(ref, est);
+  m.rotation_rmse_deg = thesisRotationRmseDeg(ref, est);
+  m.mean_abs_error_m = meanAbsoluteError(ref, est);
+  m.end_point_m = (est.back().p_m - ref.back().p_m).norm();
+
+  // Segment boundaries [begin, end) in the evaluated pairs.
+  std::vector<std::pair<std::size_t, std::size_t>> segments;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (i == 0 || segment_of[i] != segment_of[i - 1]) segments.emplace_back(i, i);
+    segments.back().second = i + 1;
+  }
+  m.track_length_m = 0;
+  m.truth_track_length_m = 0;
+  for (const auto& [begin, end] : segments) {
+    std::size_t last = begin;
+    for (std::size_t i = begin + 1; i < end; ++i) {
+      if (i + 1 != end && ref[i].t_s - ref[last].t_s < options.track_length_interval_s) continue;
+      m.track_length_m += (est[i].p_m - est[last].p_m).norm();
+      m.truth_track_length_m += (ref[i].p_m - ref[last].p_m).norm();
+      last = i;
+    }
+  }
+  m.track_length_diff_pct =
+      percentOf(m.track_length_m - m.truth_track_length_m, m.truth_track_length_m);
+  m.end_point_pct = percentOf(m.end_point_m, m.truth_track_length_m);
+
+  // evo's APE and RPE on the aligned estimate.
+  Alignment alignment;
+  try {
+    alignment = alignTrajectories(ref, est, parseAlignMode(options.align));
+  } catch (const EvalError& error) {
+    appendNote(m.note, std::string("no APE or RPE: ") + error.what());
+    return m;
+  }
+  m.alignment_scale = alignment.scale;
+  PoseTrajectory aligned = est;
+  applyAlignment(alignment, aligned);
+  m.ape_translation_m = computeStatistics(apeTranslationErrors(ref, aligned));
+  m.ape_rotation_deg = computeStatistics(apeRotationErrorsDeg(ref, aligned));
+
+  IndexPairs pairs;
+  const DeltaUnit unit = parseDeltaUnit(options.rpe_delta_unit);
+  for (const auto& [begin, end] : segments) {
+    const PoseTrajectory slice(aligned.begin() + static_cast<std::ptrdiff_t>(begin),
+                               aligned.begin() + static_cast<std::ptrdiff_t>(end));
+    for (const auto& [i, j] : rpePairs(slice, options.rpe_delta, unit)) {
+      pairs.emplace_back(begin + i, begin + j);
+    }
+  }
+  if (pairs.empty()) {
+    appendNote(m.note, "no RPE pose pair at this delta");
+  } else {
+    const RelativeErrors relative = rpeErrors(ref, aligned, pairs);
+    m.rpe_translation_m = computeStatistics(relative.translation_m);
+    m.rpe_rotation_deg = computeStatistics(relative.rotation_deg);
+  }
+  return m;
+}
+
+RunMetrics evaluate(const PoseTrajectory& truth,
+                    const std::map<std::string, std::vector<SourceEstimate>>& sources,
+                    const EvalOptions& options) {
+  RunMetrics run;
+  run.truth_poses = truth.size();
+  run.truth_track_length_m = trackLength(truth);
+  run.truth_duration_s = truth.empty() ? 0.0 : truth.back().t_s - truth.front().t_s;
+  for (const auto& [name, estimates] : sources) {
+    run.sources[name] = evaluateSource(truth, estimates, options);
+  }
+  if (sources.empty()) validateOptions(options);
+  return run;
+}
+
+std::map<std::string, std::string> defaultSourceChannels() {
+  return {{"POSE_PPA", "ppa"}, {"POSE_VO_FEATURE", "vo_feature"}, {"POSE_VO_DIRECT", "vo_direct"}};
+}
+
+TrajectoryCollector::TrajectoryCollector(std::map<std::string, std::string> source_channels)
+    : source_channels_(std::move(source_channels)) {}
+
+namespace {
+
+// The pose of a pose_t; nothing for a non-finite position or a quaternion that is
+// not a rotation.
+std::optional<StampedPose> stampedPose(const nadir::pose_t& message) {
+  StampedPose pose;
+  pose.t_s = static_cast<double>(message.utime) / 1e6;
+  pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
+  if (!pose.p_m.allFinite()) return std::nullopt;
+  try {
+    pose.q = core::quaternionFromWire(message.orientation);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return pose;
+}
+
+}  // namespace
+
+bool TrajectoryCollector::add(const std::string& channel, const void* data, std::size_t size) {
+  if (channel == kTruthChannel) {
+    nadir::pose_t message;
+    const std::optional<StampedPose> pose =
+        core::decodeMessage(data, size, message) ? stampedPose(message) : std::nullopt;
+    if (pose) {
+      truth_.push_back(*pose);
+    } else {
+      ++undecodable_[channel];
+    }
+    return true;
+  }
+  const auto source = source_channels_.find(channel);
+  if (source == source_channels_.end()) return false;
+  nadir::vo_estimate_t message;
+  if (!core::decodeMessage(data, size, message)) {
+    ++undecodable_[channel];
+    return true;
+  }
+  SourceEstimate estimate;
+  estimate.t_s = static_cast<double>(message.utime) / 1e6;
+  estimate.status = message.status;
+  if (estimate.status == SourceEstimate::kTracking) {
+    const std::optional<StampedPose> pose = stampedPose(message.pose);
+    if (!pose) {
+      ++undecodable_[channel];
+      return true;
+    }
+    estimate.p_m = pose->p_m;
+    estimate.q = pose->q;
+  }
+  sources_[source->second].push_back(estimate);
+  return true;
+}
+
+std::string TrajectoryCollector::undecodableReport() const {
+  std::string report;
+  for (const auto& [channel, count] : undecodable_) {
+    appendNote(report, std::to_string(count) + " undecodable or invalid message" +
+                           (count == 1 ? "" : "s") + " on " + channel);
+  }
+  return report;
+}
+
+LogTrajectories TrajectoryCollector::trajectories() const {
+  LogTrajectories out;
+  out.truth = truth_;
+  out.sources = sources_;
+  out.damage = undecodableReport();
+  std::stable_sort(out.truth.begin(), out.truth.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.t_s < b.t_s; });
+  const auto duplicate =
+      std::unique(out.truth.begin(), out.truth.end(),
+                  [](const StampedPose& a, const StampedPose& b) { return a.t_s == b.t_s; });
+  out.truth.erase(duplicate, out.truth.end());
+  for (auto& [name, estimates] : out.sources) {
+    std::stable_sort(
+        estimates.begin(), estimates.end(),
+        [](const SourceEstimate& a, const SourceEstimate& b) { return a.t_s < b.t_s; });
+  }
+  return out;
+}
+
+LogTrajectories readRunLog(const std::string& log_path,
+                           const std::map<std::string, std::string>& source_channels) {
+  TrajectoryCollector collector(source_channels);
+  std::size_t events = 0;
+  std::string reader_damage;
+  try {
+    core::LcmLogReader reader(log_path);
+    while (const std::optional<core::LogEvent> event = reader.next()) {
+      ++events;
+      collector.add(event->channel, event->data.data(), event->data.size());
+    }
+    reader_damage = reader.damageReport();
+  } catch (const core::LogError& error) {
+    throw EvalError(error.what());
+  }
+  if (events == 0) throw EvalError(log_path + ": the log is empty (no events)");
+  if (collector.truthPoses() == 0) {
+    throw EvalError(log_path + ": no truth: no valid pose_t on " + kTruthChannel + " among " +
+                    std::to_string(events) + " events");
+  }
+  LogTrajectories out = collector.trajectories();
+  std::string damage = std::move(reader_damage);
+  if (!out.damage.empty()) appendNote(damage, out.damage);
+  out.damage = std::move(damage);
+  return out;
+}
+
+PoseTrajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates) {
+  PoseTrajectory trajectory;
+  for (const SourceEstimate& e : estimates) {
+    if (e.status != SourceEstimate::kTracking) continue;
+    // TUM needs strictly increasing stamps: keep the first of equal stamps.
+    if (!trajectory.empty() && e.t_s <= trajectory.back().t_s) continue;
+    trajectory.push_back(StampedPose{e.t_s, e.p_m, e.q.normalized()});
+  }
+  return trajectory;
+}
+
+RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
+                             const EvalOptions& options) {
+  RunEvaluation run;
+  run.recorded = readRunLog(log_path);
+  run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options);
+  const std::filesystem::path dir(out_dir.empty() ? std::string(".") : out_dir);
+  run.metrics_path = (dir / "metrics.json").string();
+  writeMetricsJson(run.metrics_path, run.metrics, options);
+  run.tum_paths.push_back((dir / "truth.tum").string());
+  writeTum(run.tum_paths.back(), run.recorded.truth);
+  for (const auto& [name, estimates] : run.recorded.sources) {
+    PoseTrajectory tracked = trackingTrajectory(estimates);
+    if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
+    run.tum_paths.push_back((dir / (name + ".tum")).string());
+    writeTum(run.tum_paths.back(), tracked);
+    run.tracked.emplace(name, std::move(tracked));
+  }
+  return run;
+}
+
+void writeMetricsJson(const std::string& path, const RunMetrics& metrics,
+                      const EvalOptions& options) {
+  Json j;
+  j["schema"] = "nadir.metrics";
+  j["version"] = 1;
+  j["truth"] = Json{{"track_length_m", number(metrics.truth_track_length_m)},
+                    {"duration_s", number(metrics.truth_duration_s)},
+                    {"poses", metrics.truth_poses}};
+  j["options"] = Json{{"align", options.align},
+                      {"t_max_diff_s", options.t_max_diff_s},
+                      {"rpe_delta", options.rpe_delta},
+                      {"rpe_delta_unit", options.rpe_delta_unit},
+                      {"tracked_hold_periods", options.tracked_hold_periods},
+                      {"truth_max_gap_s", options.truth_max_gap_s},
+                      {"track_length_interval_s", options.track_length_interval_s}};
+  Json sources = Json::object();
+  for (const auto& [name, source] : metrics.sources) sources[name] = sourceJson(source);
+  j["sources"] = sources;
+  std::ofstream out(path, std::ios::trunc);
+  if (!out) throw EvalError(path + ": cannot open the file for writing");
+  out << j.dump(2) << "\n";
+  out.flush();
+  if (!out) throw EvalError(path + ": write error");
+}
+
+RunMetrics readMetricsJson(const std::string& path, EvalOptions* options) {
+  std::ifstream in(path);
+  if (!in) throw EvalError(path + ": cannot open the file for reading");
+  Json j;
+  try {
+    j = Json::parse(in);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw EvalError(path + ": not valid JSON: " + error.what());
+  }
+  const JsonReader r(path);
+  if (r.text(j, "schema", "top level") != "nadir.metrics") {
+    r.fail("schema", "is not 'nadir.metrics'");
+  }
+  if (r.number(j, "version", "top level") != 1) r.fail("version", "is not 1 (not supported)");
+  RunMetrics metrics;
+  const Json& truth = r.at(j, "truth", "top level");
+  metrics.truth_track_length_m = r.number(truth, "track_length_m", "truth");
+  metrics.truth_duration_s = r.number(truth, "duration_s", "truth");
+  metrics.truth_poses = r.count(truth, "poses", "truth");
+  if (options != nullptr) {
+    const Json& o = r.at(j, "options", "top level");
+    options->align = r.text(o, "align", "options");
+    options->t_max_diff_s = r.number(o, "t_max_diff_s", "options");
+    options->rpe_delta = r.number(o, "rpe_delta", "options");
+    options->rpe_delta_unit = r.text(o, "rpe_delta_unit", "options");
+    options->tracked_hold_periods = r.number(o, "tracked_hold_periods", "options");
+    options->track_length_interval_s = r.number(o, "track_length_interval_s", "options");
+    options->truth_max_gap_s = r.number(o, "truth_max_gap_s", "options");
+  }
+  const Json& sources = r.at(j, "sources", "top level");
+  if (!sources.is_object()) r.fail("sources", "is not an object");
+  for (const auto& [name, source] : sources.items()) {
+    metrics.sources[name] = sourceFromJson(r, source, "sources." + name);
+  }
+  return metrics;
+}
+
+std::string formatResultsTable(const RunMetrics& metrics) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "truth: %.1f m in %.1f s (%zu poses)\n",
+                metrics.truth_track_length_m, metrics.truth_duration_s, metrics.truth_poses);
+  out += line;
+  const char* const row_format = "%-12s %5s %9s %11s %13s %11s %11s %11s %9s %9s %7s %8s\n";
+  std::snprintf(line, sizeof line, row_format, "source", "init", "tracked%", "pos RMSE m",
+                "rot RMSE deg", "APE RMSE m", "RPE RMSE m", "len diff %", "MAE m", "end m", "end %",
+                "rate Hz");
+  out += line;
+  for (const auto& [name, m] : metrics.sources) {
+    std::snprintf(line, sizeof line, row_format, name.c_str(), m.initialised ? "yes" : "no",
+                  cell(m.tracked_pct, 1).c_str(), cell(m.position_rmse_m, 3).c_str(),
+                  cell(m.rotation_rmse_deg, 3).c_str(), cell(m.ape_translation_m.rmse, 3).c_str(),
+                  cell(m.rpe_translation_m.rmse, 3).c_str(),
+                  cell(m.track_length_diff_pct, 2).c_str(), cell(m.mean_abs_error_m, 3).c_str(),
+                  cell(m.end_point_m, 3).c_str(), cell(m.end_point_pct, 2).c_str(),
+                  cell(m.rate_hz, 1).c_str());
+    out += line;
+  }
+  if (metrics.sources.empty()) {
+    out += "(no VO source in the run)\n";
+  } else {
+    const SourceMetrics& first = metrics.sources.begin()->second;
+    std::snprintf(line, sizeof line, "APE alignment: %s; RPE delta: %g %s\n",
+                  first.alignment.c_str(), first.rpe_delta, first.rpe_delta_unit.c_str());
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace nadir::eval

@@ -1,0 +1,878 @@
+#include "logs/export/export.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/bus.h"
+#include "core/clock.h"
+#include "core/frames.h"
+#include "core/lcm_log.h"
+#include "logs/eval/trajectory.h"
+#include "nadir/camera_info_t.hpp"
+#include "nadir/image_t.hpp"
+#include "nadir/imu_t.hpp"
+#include "nadir/pose_t.hpp"
+#include "nodes/camera/camera_messages.h"
+
+namespace nadir::dataset {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Truth is interpolated only between samples at most this far apart: a wider
+// gap means truth is missing there (a damaged log), not a slow truth stream.
+constexpr std::int64_t kMaxTruthGapUs = 500'000;
+
+struct ImuSample {
+  std::int64_t utime = 0;
+  Eigen::Vector3d gyro_rps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+};
+
+// One pose_t of the truth channel: T_world_body (world local NED, body FRD).
+struct TruthSample {
+  std::int64_t utime = 0;
+  Eigen::Vector3d p_body_in_world_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d v_world_mps = Eigen::Vector3d::Zero();
+};
+
+struct Calibration {
+  nadir::camera_info_t info;
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+};
+
+// What the first pass over the log finds: everything but the pixels.
+struct Scan {
+  std::optional<Calibration> calibration;
+  std::optional<std::int64_t> calibration_changed_utime;
+  std::vector<TruthSample> truth;
+  std::vector<ImuSample> imu;
+  std::int64_t camera_images = 0;
+  std::int64_t camera_other_messages = 0;
+  std::map<std::string, std::int64_t> image_channels;
+  std::map<std::string, std::int64_t> info_channels;
+  std::map<std::string, std::int64_t> all_channels;
+  std::map<std::string, std::int64_t> undecodable;
+  std::int64_t truth_duplicates = 0;
+  std::int64_t imu_duplicates = 0;
+  std::string damage;
+};
+
+// The LCM fingerprint (the first 8 bytes, big-endian) says which type a message is.
+template <class Msg>
+bool hasFingerprint(const std::vector<std::uint8_t>& data) {
+  if (data.size() < 8) return false;
+  std::uint64_t hash = 0;
+  for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[static_cast<std::size_t>(i)];
+  return static_cast<std::int64_t>(hash) == Msg::getHash();
+}
+
+template <class Msg>
+bool decode(const core::LogEvent& event, Msg& message) {
+  return hasFingerprint<Msg>(event.data) &&
+         core::decodeMessage(event.data.data(), event.data.size(), message);
+}
+
+std::string plural(std::int64_t count, const std::string& word) {
+  return std::to_string(count) + " " + word + (count == 1 ? "" : "s");
+}
+
+std::string channelList(const std::map<std::string, std::int64_t>& channels,
+                        const std::string& word) {
+  std::string text;
+  for (const auto& [channel, count] : channels) {
+    if (!text.empty()) text += ", ";
+    text += channel + " (" + plural(count, word) + ")";
+  }
+  return text;
+}
+
+bool sameCalibration(const nadir::camera_info_t& a, const nadir::camera_info_t& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
+         a.cx == b.cx && a.cy == b.cy && a.distortion_model == b.distortion_model &&
+         a.distortion == b.distortion &&
+         std::equal(std::begin(a.position_cam_in_body_m), std::end(a.position_cam_in_body_m),
+                    std::begin(b.position_cam_in_body_m)) &&
+         std::equal(std::begin(a.orientation_body_cam), std::end(a.orientation_body_cam),
+                    std::begin(b.orientation_body_cam));
+}
+
+std::optional<Calibration> calibrationFrom(const nadir::camera_info_t& info) {
+  Calibration calibration;
+  calibration.info = info;
+  try {
+    calibration.T_body_cam.linear() =
+        core::quaternionFromWire(info.orientation_body_cam).toRotationMatrix();
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+  calibration.T_body_cam.translation() =
+      Eigen::Vector3d(info.position_cam_in_body_m[0], info.position_cam_in_body_m[1],
+                      info.position_cam_in_body_m[2]);
+  if (!calibration.T_body_cam.matrix().allFinite() || !std::isfinite(info.fx) ||
+      !std::isfinite(info.fy) || !std::isfinite(info.cx) || !std::isfinite(info.cy) ||
+      info.fx <= 0 || info.fy <= 0 || info.width <= 0 || info.height <= 0) {
+    return std::nullopt;
+  }
+  return calibration;
+}
+
+std::optional<TruthSample> truthFrom(const nadir::pose_t& pose) {
+  TruthSample sample;
+  sample.utime = pose.utime;
+  sample.p_body_in_world_m = Eigen::Vector3d(pose.pos[0], pose.pos[1], pose.pos[2]);
+  sample.v_world_mps = Eigen::Vector3d(pose.vel[0], pose.vel[1], pose.vel[2]);
+  if (!sample.p_body_in_world_m.allFinite()) return std::nullopt;
+  try {
+    sample.q_world_body = core::quaternionFromWire(pose.orientation);
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+  if (!sample.v_world_mps.allFinite()) sample.v_world_mps.setZero();
+  return sample;
+}
+
+// Sorts by utime and keeps the first of samples that share a time; returns how many went.
+template <class T>
+std::int64_t sortByTime(std::vector<T>& samples) {
+  std::stable_sort(samples.begin(), samples.end(),
+                   [](const T& a, const T& b) { return a.utime < b.utime; });
+  const auto end = std::unique(samples.begin(), samples.end(),
+                               [](const T& a, const T& b) { return a.utime == b.utime; });
+  const auto dropped = static_cast<std::int64_t>(std::distance(end, samples.end()));
+  samples.erase(end, samples.end());
+  return dropped;
+}
+
+std::unique_ptr<core::LcmLogReader> openLog(const std::string& path) {
+  try {
+    return std::make_unique<core::LcmLogReader>(path);
+  } catch (const core::LogError& error) {
+    throw ExportError(error.what());
+  }
+}
+
+Scan scanLog(const ExportOptions& options, const std::string& info_channel) {
+  Scan scan;
+  auto reader = openLog(options.log_path);
+  try {
+    while (auto event = reader->next()) {
+      ++scan.all_channels[event->channel];
+      if (hasFingerprint<nadir::image_t>(event->data)) ++scan.image_channels[event->channel];
+      if (hasFingerprint<nadir::camera_info_t>(event->data)) ++scan.info_channels[event->channel];
+      if (event->channel == options.camera_channel) {
+        if (hasFingerprint<nadir::image_t>(event->data)) {
+          ++scan.camera_images;
+        } else {
+          ++scan.camera_other_messages;
+        }
+      }
+      if (event->channel == info_channel) {
+        nadir::camera_info_t info;
+        std::optional<Calibration> calibration;
+        if (decode(*event, info)) calibration = calibrationFrom(info);
+        if (!calibration) {
+          ++scan.undecodable[info_channel];
+        } else if (!scan.calibration) {
+          scan.calibration = calibration;
+        } else if (!scan.calibration_changed_utime &&
+                   !sameCalibration(scan.calibration->info, info)) {
+          scan.calibration_changed_utime = info.utime;
+        }
+      }
+      if (event->channel == options.truth_channel) {
+        nadir::pose_t pose;
+        std::optional<TruthSample> sample;
+        if (decode(*event, pose)) sample = truthFrom(pose);
+        if (sample) {
+          scan.truth.push_back(*sample);
+        } else {
+          ++scan.undecodable[options.truth_channel];
+        }
+      }
+      if (event->channel == options.imu_channel) {
+        nadir::imu_t imu;
+        if (decode(*event, imu)) {
+          ImuSample sample;
+          sample.utime = imu.utime;
+          sample.gyro_rps =
+              Eigen::Vector3d(imu.angular_velocity_rps[0], imu.angular_velocity_rps[1],
+                              imu.angular_velocity_rps[2]);
+          sample.accel_mps2 =
+              Eigen::Vector3d(imu.linear_acceleration_mps2[0], imu.linear_acceleration_mps2[1],
+                              imu.linear_acceleration_mps2[2]);
+          scan.imu.push_back(sample);
+        } else {
+          ++scan.undecodable[options.imu_channel];
+        }
+      }
+    }
+  } catch (const core::LogError& error) {
+    throw ExportError(error.what());
+  }
+  scan.damage = reader->damageReport();
+  scan.truth_duplicates = sortByTime(scan.truth);
+  scan.imu_duplicates = sortByTime(scan.imu);
+  return scan;
+}
+
+// ------------------------------------------------------------------ text output
+
+std::string number(double value) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.12g", value);
+  return text;
+}
+
+// utime as seconds with exactly six decimals (no rounding through a double).
+std::string secondsText(std::int64_t utime) {
+  const bool negative = utime < 0;
+  const std::uint64_t magnitude =
+      negative ? 0 - static_cast<std::uint64_t>(utime) : static_cast<std::uint64_t>(utime);
+  char text[48];
+  std::snprintf(text, sizeof(text), "%s%llu.%06llu", negative ? "-" : "",
+                static_cast<unsigned long long>(magnitude / 1'000'000),
+                static_cast<unsigned long long>(magnitude % 1'000'000));
+  return text;
+}
+
+std::string nanosecondsText(std::int64_t utime) { return std::to_string(utime * 1000); }
+
+class TextFile {
+ public:
+  explicit TextFile(fs::path path) : path_(std::move(path)), out_(path_) {
+    if (!out_) throw ExportError("cannot create " + path_.string());
+  }
+  TextFile& operator<<(const std::string& text) {
+    out_ << text;
+    return *this;
+  }
+  void close() {
+    out_.close();
+    if (out_.fail()) throw ExportError("cannot write " + path_.string());
+  }
+
+ private:
+  fs::path path_;
+  std::ofstream out_;
+};
+
+void writeText(const fs::path& path, const std::string& text) {
+  TextFile file(path);
+  file << text;
+  file.close();
+}
+
+void createFolder(const fs::path& path) {
+  std::error_code error;
+  fs::create_directories(path, error);
+  if (error) throw ExportError("cannot create folder " + path.string() + ": " + error.message());
+}
+
+// A 4x4 matrix as EuRoC's sensor.yaml writes it (row-major data list).
+std::string yamlMatrix(const Eigen::Isometry3d& T, const std::string& indent) {
+  const Eigen::Matrix4d M = T.matrix();
+  std::string text = indent + "cols: 4\n" + indent + "rows: 4\n" + indent + "data: [";
+  for (int r = 0; r < 4; ++r) {
+    if (r > 0) text += ",\n" + indent + "       ";
+    for (int c = 0; c < 4; ++c) {
+      // Rounding leaves 1e-16 where a rotation has an exact 0; write the 0.
+      const double value = std::abs(M(r, c)) < 1e-12 ? 0.0 : M(r, c);
+      text += (c > 0 ? ", " : "") + number(value);
+    }
+  }
+  return text + "]\n";
+}
+
+std::string listOf(const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i > 0 ? ", " : "") + number(values[i]);
+  return text + "]";
+}
+
+// The first `count` coefficients (zero-padded); a note if non-zero ones are cut.
+std::vector<double> firstCoefficients(const nadir::camera_info_t& info, std::size_t count,
+                                      const std::string& format_name,
+                                      std::vector<std::string>& notes) {
+  std::vector<double> coefficients(count, 0.0);
+  for (std::size_t i = 0; i < info.distortion.size(); ++i) {
+    if (i < count) {
+      coefficients[i] = info.distortion[i];
+    } else if (info.distortion[i] != 0.0) {
+      notes.push_back(format_name + " takes " + std::to_string(count) +
+                      " distortion coefficients: coefficient " + std::to_string(i + 1) + " (" +
+                      number(info.distortion[i]) + ") is not in the calibration file");
+    }
+  }
+  return coefficients;
+}
+
+struct ImageRecord {
+  std::int64_t utime = 0;
+  std::string file;  // relative to the folder that holds the index file
+  double exposure_ms = 0.0;
+};
+
+double exposureMs(const nadir::image_t& image) {
+  for (const auto& entry : image.metadata) {
+    if (entry.key != "exposure_s") continue;
+    try {
+      const double seconds = std::stod(std::string(entry.value.begin(), entry.value.end()));
+      if (std::isfinite(seconds) && seconds > 0) return seconds * 1000.0;
+    } catch (const std::exception&) {
+    }
+  }
+  return 0.0;
+}
+
+// ------------------------------------------------------------------ the layouts
+
+struct Layout {
+  fs::path image_dir;  // where the PNGs go
+  std::function<std::string(std::int64_t utime, std::int64_t index)> name;
+};
+
+Layout layoutFor(Format format, const fs::path& out) {
+  switch (format) {
+    case Format::kEuroc:
+      return {out / "mav0" / "cam0" / "data",
+              [](std::int64_t utime, std::int64_t) { return nanosecondsText(utime) + ".png"; }};
+    case Format::kTumMono:
+      return {out / "images", [](std::int64_t, std::int64_t index) {
+                char text[32];
+                std::snprintf(text, sizeof(text), "%05lld.png", static_cast<long long>(index));
+                return std::string(text);
+              }};
+    case Format::kTum:
+      return {out / "rgb",
+              [](std::int64_t utime, std::int64_t) { return secondsText(utime) + ".png"; }};
+  }
+  throw std::logic_error("unknown export format");
+}
+
+struct Context {
+  const ExportOptions& options;
+  const Scan& scan;
+  const Calibration& calibration;
+  fs::path out;
+  std::vector<ImageRecord> images;
+  ExportSummary& summary;
+};
+
+std::string sourceLine(const Context& context) {
+  return "nadir export of " + context.options.camera_channel + " from " + context.options.log_path;
+}
+
+double cameraRateHz(const Context& context) {
+  if (context.calibration.info.fps > 0) return context.calibration.info.fps;
+  if (context.images.size() < 2) return 0.0;
+  const double span_s =
+      static_cast<double>(context.images.back().utime - context.images.front().utime) * 1e-6;
+  return span_s > 0 ? static_cast<double>(context.images.size() - 1) / span_s : 0.0;
+}
+
+double medianRateHz(const std::vector<ImuSample>& samples) {
+  if (samples.size() < 2) return 0.0;
+  std::vector<std::int64_t> dts;
+  dts.reserve(samples.size() - 1);
+  for (std::size_t i = 1; i < samples.size(); ++i)
+    dts.push_back(samples[i].utime - samples[i - 1].utime);
+  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2),
+                   dts.end());
+  const std::int64_t median = dts[dts.size() / 2];
+  return median > 0 ? 1e6 / static_cast<double>(median) : 0.0;
+}
+
+// Ground truth of the camera at each image time: T_world_cam = T_world_body * T_body_cam.
+void writeTumTrajectory(Context& context, const fs::path& path) {
+  TextFile file(path);
+  file << "# ground truth: pose of the camera (OpenCV optical frame: x right, y down, z along the "
+          "optical axis) in nadir's world frame (local NED), T_world_cam, interpolated at the "
+          "image times\n";
+  file << "# " + sourceLine(context) + ", truth from " + context.options.truth_channel + "\n";
+  file << "# timestamp tx ty tz qx qy qz qw\n";
+  std::int64_t missing = 0;
+  eval::PoseTrajectory truth;
+  for (const TruthSample& sample : context.scan.truth) {
+    truth.push_back(
+        {core::secondsFromUtime(sample.utime), sample.p_body_in_world_m, sample.q_world_body});
+  }
+  for (const ImageRecord& image : context.images) {
+    const auto body = eval::interpolate(truth, core::secondsFromUtime(image.utime),
+                                        core::secondsFromUtime(kMaxTruthGapUs));
+    if (!body) {
+      ++missing;
+      continue;
+    }
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.linear() = body->q.toRotationMatrix();
+    T_world_body.translation() = body->p_m;
+    const Eigen::Isometry3d T_world_cam = T_world_body * context.calibration.T_body_cam;
+    const Eigen::Vector3d p = T_world_cam.translation();
+    const Eigen::Quaterniond q(T_world_cam.rotation());
+    file << secondsText(image.utime) + " " + number(p.x()) + " " + number(p.y()) + " " +
+                number(p.z()) + " " + number(q.x()) + " " + number(q.y()) + " " + number(q.z()) +
+                " " + number(q.w()) + "\n";
+    ++context.summary.poses;
+  }
+  file.close();
+  if (missing > 0 && !context.scan.truth.empty()) {
+    context.summary.notes.push_back(plural(missing, "image") + " outside the truth's time span " +
+                                    "(or in a gap in it) have no line in " +
+                                    path.filename().string());
+  }
+}
+
+std::string framesReadme(const Context& context, const std::string& layout,
+                         const std::string& truth) {
+  const auto& info = context.calibration.info;
+  return "# " + sourceLine(context) + "\n\n" + layout +
+         "\n\n## Frames and units\n\n"
+         "- World: nadir's local NED at the scenario's origin (x north, y east, z down), metres.\n"
+         "- Body: FRD (x forward, y right, z down); the IMU is mounted on it, aligned, at its "
+         "origin.\n"
+         "- Camera: OpenCV optical (x right, y down the image, z along the optical axis).\n"
+         "- Quaternions are Hamilton.\n- " +
+         truth +
+         "\n\n## Camera\n\n"
+         "- " +
+         std::to_string(info.width) + "x" + std::to_string(info.height) + " px, fx " +
+         number(info.fx) + ", fy " + number(info.fy) + ", cx " + number(info.cx) + ", cy " +
+         number(info.cy) + " (pixel centres; the top-left pixel's centre is (0, 0))\n" +
+         "- distortion coefficients (model " + std::to_string(info.distortion_model) +
+         ": 0 none, 1 radial-tangential k1 k2 p1 p2 [k3], 2 equidistant k1 k2 k3 k4): " +
+         listOf(info.distortion) + "\n- T_body_cam: camera at " +
+         number(info.position_cam_in_body_m[0]) + ", " + number(info.position_cam_in_body_m[1]) +
+         ", " + number(info.position_cam_in_body_m[2]) +
+         " m in the body frame, R_body_cam (w x y z) " +
+         listOf({info.orientation_body_cam[0], info.orientation_body_cam[1],
+                 info.orientation_body_cam[2], info.orientation_body_cam[3]}) +
+         "\n\nCounts: " + plural(context.summary.images, "image") + ", " +
+         plural(context.summary.poses, "ground-truth pose") + ", " +
+         plural(context.summary.imu_samples, "IMU sample") + ".\n";
+}
+
+void writeEuroc(Context& context) {
+  const fs::path mav = context.out / "mav0";
+  const auto& info = context.calibration.info;
+  auto& notes = context.summary.notes;
+
+  // cam0
+  {
+    TextFile csv(mav / "cam0" / "data.csv");
+    csv << "#timestamp [ns],filename\n";
+    for (const ImageRecord& image : context.images)
+      csv << nanosecondsText(image.utime) + "," + image.file + "\n";
+    csv.close();
+    std::string model = "radial-tangential";
+    std::vector<double> coefficients;
+    if (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT) {
+      model = "equidistant";
+      coefficients = firstCoefficients(info, 4, "EuRoC's equidistant model", notes);
+    } else {
+      coefficients = firstCoefficients(info, 4, "EuRoC's radial-tangential model", notes);
+    }
+    writeText(mav / "cam0" / "sensor.yaml",
+              "# " + sourceLine(context) +
+                  "\n# General sensor definitions.\nsensor_type: camera\ncomment: nadir camera '" +
+                  info.camera_name + "' on " + context.options.camera_channel +
+                  "\n\n# Sensor extrinsics wrt. the body-frame: T_body_cam, body FRD (= imu0), "
+                  "camera OpenCV optical.\nT_BS:\n" +
+                  yamlMatrix(context.calibration.T_body_cam, "  ") +
+                  "\n# Camera specific definitions.\nrate_hz: " + number(cameraRateHz(context)) +
+                  "\nresolution: [" + std::to_string(info.width) + ", " +
+                  std::to_string(info.height) + "]\ncamera_model: pinhole\nintrinsics: [" +
+                  number(info.fx) + ", " + number(info.fy) + ", " + number(info.cx) + ", " +
+                  number(info.cy) + "] #fu, fv, cu, cv\ndistortion_model: " + model +
+                  "\ndistortion_coefficients: " + listOf(coefficients) + "\n");
+  }
+
+  // imu0: the IMU frame is the body frame.
+  {
+    createFolder(mav / "imu0");
+    TextFile csv(mav / "imu0" / "data.csv");
+    csv << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+           "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+    for (const ImuSample& s : context.scan.imu) {
+      csv << nanosecondsText(s.utime) + "," + number(s.gyro_rps.x()) + "," +
+                 number(s.gyro_rps.y()) + "," + number(s.gyro_rps.z()) + "," +
+                 number(s.accel_mps2.x()) + "," + number(s.accel_mps2.y()) + "," +
+                 number(s.accel_mps2.z()) + "\n";
+      ++context.summary.imu_samples;
+    }
+    csv.close();
+    writeText(mav / "imu0" / "sensor.yaml",
+              "# " + sourceLine(context) + ", IMU from " + context.options.imu_channel +
+                  "\n#Default imu sensor yaml file\nsensor_type: imu\ncomment: nadir IMU, body "
+                  "FRD, specific force (a level vehicle at rest reads 0, 0, -9.81)\n\n"
+                  "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" +
+                  yamlMatrix(Eigen::Isometry3d::Identity(), "  ") +
+                  "rate_hz: " + number(medianRateHz(context.scan.imu)) +
+                  "\n\n# The noise densities and random walks are the scenario's sensors.imu "
+                  "parameters; the log does not carry them.\n");
+    if (context.scan.imu.empty()) {
+      notes.push_back("no imu_t on " + context.options.imu_channel +
+                      ": mav0/imu0/data.csv has only its header");
+    }
+  }
+
+  // state_groundtruth_estimate0: the body at the truth rate.
+  {
+    createFolder(mav / "state_groundtruth_estimate0");
+    TextFile csv(mav / "state_groundtruth_estimate0" / "data.csv");
+    csv << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], "
+           "q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], "
+           "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
+           "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
+    for (const TruthSample& s : context.scan.truth) {
+      const Eigen::Quaterniond& q = s.q_world_body;
+      csv << nanosecondsText(s.utime) + "," + number(s.p_body_in_world_m.x()) + "," +
+                 number(s.p_body_in_world_m.y()) + "," + number(s.p_body_in_world_m.z()) + "," +
+                 number(q.w()) + "," + number(q.x()) + "," + number(q.y()) + "," + number(q.z()) +
+                 "," + number(s.v_world_mps.x()) + "," + number(s.v_world_mps.y()) + "," +
+                 number(s.v_world_mps.z()) + ",0,0,0,0,0,0\n";
+      ++context.summary.poses;
+    }
+    csv.close();
+    writeText(mav / "state_groundtruth_estimate0" / "sensor.yaml",
+              "# " + sourceLine(context) + ", truth from " + context.options.truth_channel +
+                  "\nsensor_type: visual-inertial\ncomment: nadir simulator truth: the body "
+                  "(FRD, = imu0) in the world (local NED); biases are not logged and are "
+                  "written as 0\n\n# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" +
+                  yamlMatrix(Eigen::Isometry3d::Identity(), "  "));
+  }
+
+  writeText(mav / "body.yaml",
+            "# " + sourceLine(context) +
+                "\ncomment: the body frame is nadir's FRD body frame (x forward, y right, z down), "
+                "which is also the IMU frame (imu0)\n");
+
+  // One timestamp per line, as ORB-SLAM3's EuRoC examples take them.
+  {
+    TextFile times(context.out / "timestamps.txt");
+    for (const ImageRecord& image : context.images) times << nanosecondsText(image.utime) + "\n";
+    times.close();
+  }
+
+  writeText(context.out / "README.md",
+            framesReadme(
+                context,
+                "EuRoC MAV (ASL) layout:\n\n"
+                "```\nmav0/cam0/data/<timestamp_ns>.png   images\n"
+                "mav0/cam0/data.csv                  #timestamp [ns],filename\n"
+                "mav0/cam0/sensor.yaml               T_BS (= T_body_cam), rate_hz, resolution, "
+                "intrinsics, distortion\n"
+                "mav0/imu0/data.csv                  timestamp [ns], gyro (rad/s), specific force "
+                "(m/s^2), body FRD\n"
+                "mav0/state_groundtruth_estimate0/data.csv   timestamp [ns], p, q (w x y z), v, "
+                "b_w, b_a\n"
+                "timestamps.txt                      image timestamps [ns], one a line "
+                "(ORB-SLAM3's EuRoC_TimeStamps)\n```\n\n"
+                "Timestamps are the messages' utime in nanoseconds (utime * 1000): sim time, "
+                "from 0 at the start of a simulated run.",
+                "Ground truth (state_groundtruth_estimate0) is the body, T_world_body, at the "
+                "truth rate; velocity in the world frame; biases are not logged and are 0. "
+                "The body frame is the IMU frame (imu0's T_BS is the identity) and cam0's T_BS "
+                "is T_body_cam."));
+}
+
+std::string dsoCalibration(const Context& context) {
+  const auto& info = context.calibration.info;
+  const std::string size = std::to_string(info.width) + " " + std::to_string(info.height) + "\n";
+  const std::string k =
+      number(info.fx) + " " + number(info.fy) + " " + number(info.cx) + " " + number(info.cy);
+  auto& notes = context.summary.notes;
+  switch (info.distortion_model) {
+    case nadir::camera_info_t::DISTORTION_RADTAN: {
+      const auto d = firstCoefficients(info, 4, "DSO's RadTan model", notes);
+      // "crop": DSO undistorts to a pinhole image of the same size ("none" would skip that).
+      return "RadTan " + k + " " + number(d[0]) + " " + number(d[1]) + " " + number(d[2]) + " " +
+             number(d[3]) + "\n" + size + "crop\n" + size;
+    }
+    case nadir::camera_info_t::DISTORTION_EQUIDISTANT: {
+      const auto d = firstCoefficients(info, 4, "DSO's EquiDistant model", notes);
+      return "EquiDistant " + k + " " + number(d[0]) + " " + number(d[1]) + " " + number(d[2]) +
+             " " + number(d[3]) + "\n" + size + "crop\n" + size;
+    }
+    default:
+      return "Pinhole " + k + " 0\n" + size + "none\n" + size;
+  }
+}
+
+void writeTumMono(Context& context) {
+  TextFile times(context.out / "times.txt");
+  for (std::size_t i = 0; i < context.images.size(); ++i) {
+    char index[32];
+    std::snprintf(index, sizeof(index), "%05zu", i);
+    times << std::string(index) + " " + secondsText(context.images[i].utime) + " " +
+                 number(context.images[i].exposure_ms) + "\n";
+  }
+  times.close();
+  writeText(context.out / "camera.txt", dsoCalibration(context));
+  writeTumTrajectory(context, context.out / "groundtruth.txt");
+  writeText(context.out / "README.md",
+            framesReadme(context,
+                         "TUM monocular layout (DSO's dataset reader):\n\n"
+                         "```\nimages/00000.png ...   images in time order\n"
+                         "times.txt              index timestamp [s] exposure [ms] (0: unknown)\n"
+                         "camera.txt             DSO calibration: model fx fy cx cy [coefficients]"
+                         " / input w h / crop|none / output w h\n"
+                         "groundtruth.txt        timestamp [s] tx ty tz qx qy qz qw\n```\n\n"
+                         "Run DSO with files=images calib=camera.txt mode=1 (no photometric "
+                         "calibration). Timestamps are the messages' utime in seconds with six "
+                         "decimals: sim time, from 0 at the start of a simulated run.",
+                         "Ground truth (groundtruth.txt) is the camera, T_world_cam = T_world_body "
+                         "* T_body_cam, at each image time (linear position, SLERP orientation "
+                         "between the truth samples around it), as DSO's result.txt reports "
+                         "camera poses."));
+}
+
+void writeTum(Context& context) {
+  TextFile list(context.out / "rgb.txt");
+  list << "# color images\n# " + sourceLine(context) + "\n# timestamp filename\n";
+  for (const ImageRecord& image : context.images)
+    list << secondsText(image.utime) + " " + image.file + "\n";
+  list.close();
+  const auto& info = context.calibration.info;
+  std::vector<double> d;
+  if (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT) {
+    d = firstCoefficients(info, 4, "equidistant", context.summary.notes);
+    d.push_back(0.0);
+    context.summary.notes.push_back(
+        "calibration.txt: the camera is equidistant (k1 k2 k3 k4), not TUM's radial-tangential");
+  } else {
+    d = firstCoefficients(info, 5, "TUM's calibration line", context.summary.notes);
+  }
+  writeText(context.out / "calibration.txt",
+            "# " + sourceLine(context) + "\n# " + std::to_string(info.width) + "x" +
+                std::to_string(info.height) + " px; model " +
+                (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT
+                     ? "equidistant"
+                     : "radial-tangential (OpenCV)") +
+                "\n# fx fy cx cy d0 d1 d2 d3 d4\n" + number(info.fx) + " " + number(info.fy) + " " +
+                number(info.cx) + " " + number(info.cy) + " " + number(d[0]) + " " + number(d[1]) +
+                " " + number(d[2]) + " " + number(d[3]) + " " + number(d[4]) + "\n");
+  writeTumTrajectory(context, context.out / "groundtruth.txt");
+  writeText(context.out / "README.md",
+            framesReadme(context,
+                         "TUM RGB-D layout (colour only; evo's tum trajectory format):\n\n"
+                         "```\nrgb/<timestamp>.png   images\n"
+                         "rgb.txt               timestamp [s] filename\n"
+                         "groundtruth.txt       timestamp [s] tx ty tz qx qy qz qw\n"
+                         "calibration.txt       fx fy cx cy d0 d1 d2 d3 d4 (TUM's table)\n```\n\n"
+                         "Timestamps are the messages' utime in seconds with six decimals: sim "
+                         "time, from 0 at the start of a simulated run.",
+                         "Ground truth (groundtruth.txt) is the camera's optical centre and "
+                         "orientation, T_world_cam = T_world_body * T_body_cam, as in TUM RGB-D, "
+                         "at each image time (linear position, SLERP orientation between the "
+                         "truth samples around it)."));
+}
+
+// ------------------------------------------------------------------ images
+
+void writeImages(Context& context, const Layout& layout) {
+  createFolder(layout.image_dir);
+  auto reader = openLog(context.options.log_path);
+  const auto& info = context.calibration.info;
+  std::int64_t undecodable = 0;
+  std::int64_t out_of_order = 0;
+  std::int64_t wrong_size = 0;
+  std::optional<std::int64_t> last_utime;
+  std::string first_error;
+  try {
+    while (auto event = reader->next()) {
+      if (event->channel != context.options.camera_channel) continue;
+      nadir::image_t message;
+      if (!hasFingerprint<nadir::image_t>(event->data)) continue;
+      cv::Mat pixels;
+      try {
+        if (!core::decodeMessage(event->data.data(), event->data.size(), message)) {
+          throw std::invalid_argument("event " + std::to_string(event->event_number) +
+                                      " does not decode as image_t");
+        }
+        pixels = camera::imageFromMessage(message);
+      } catch (const std::invalid_argument& error) {
+        if (first_error.empty()) first_error = error.what();
+        ++undecodable;
+        continue;
+      }
+      // Every layout needs strictly increasing times (EuRoC and TUM name files by them).
+      if (last_utime && message.utime <= *last_utime) {
+        ++out_of_order;
+        continue;
+      }
+      last_utime = message.utime;
+      if (pixels.cols != info.width || pixels.rows != info.height) ++wrong_size;
+      const auto index = static_cast<std::int64_t>(context.images.size());
+      const std::string name = layout.name(message.utime, index);
+      const fs::path path = layout.image_dir / name;
+      if (pixels.channels() == 3) cv::cvtColor(pixels, pixels, cv::COLOR_RGB2BGR);
+      bool written = false;
+      try {
+        written = cv::imwrite(path.string(), pixels);
+      } catch (const cv::Exception& error) {
+        throw ExportError("cannot write " + path.string() + ": " + error.what());
+      }
+      if (!written) throw ExportError("cannot write " + path.string());
+      ImageRecord record;
+      record.utime = message.utime;
+      record.file = context.options.format == Format::kTum ? "rgb/" + name : name;
+      record.exposure_ms = exposureMs(message);
+      context.images.push_back(record);
+      ++context.summary.images;
+      if (context.options.progress)
+        context.options.progress(context.summary.images, context.scan.camera_images);
+    }
+  } catch (const core::LogError& error) {
+    throw ExportError(error.what());
+  }
+  auto& notes = context.summary.notes;
+  if (undecodable > 0) {
+    notes.push_back(plural(undecodable, "image") + " on " + context.options.camera_channel +
+                    " did not decode and were skipped (first: " + first_error + ")");
+  }
+  if (out_of_order > 0) {
+    notes.push_back(plural(out_of_order, "image") + " on " + context.options.camera_channel +
+                    " had a utime not after the previous image's and were skipped");
+  }
+  if (wrong_size > 0) {
+    notes.push_back(plural(wrong_size, "image") + " differ in size from the camera_info_t's " +
+                    std::to_string(info.width) + "x" + std::to_string(info.height));
+  }
+}
+
+void checkOutputFolder(const fs::path& out) {
+  std::error_code error;
+  if (!fs::exists(out, error)) return;
+  if (!fs::is_directory(out, error)) {
+    throw ExportError(out.string() + " exists and is not a folder: refusing to overwrite it");
+  }
+  if (!fs::is_empty(out, error)) {
+    throw ExportError("output folder " + out.string() +
+                      " exists and is not empty: refusing to overwrite it (remove it or choose "
+                      "another output folder)");
+  }
+}
+
+}  // namespace
+
+Format parseFormat(const std::string& name) {
+  if (name == "euroc") return Format::kEuroc;
+  if (name == "tum-mono") return Format::kTumMono;
+  if (name == "tum") return Format::kTum;
+  throw std::invalid_argument("unknown export format '" + name + "' (known: euroc, tum-mono, tum)");
+}
+
+std::string formatName(Format format) {
+  switch (format) {
+    case Format::kEuroc:
+      return "euroc";
+    case Format::kTumMono:
+      return "tum-mono";
+    case Format::kTum:
+      return "tum";
+  }
+  return "unknown";
+}
+
+ExportSummary exportRun(const ExportOptions& options) {
+  const fs::path log_path(options.log_path);
+  std::error_code error;
+  if (options.log_path.empty()) throw ExportError("no LCM log given");
+  if (!fs::exists(log_path, error)) throw ExportError("no LCM log at " + options.log_path);
+  if (fs::is_directory(log_path, error)) {
+    throw ExportError(options.log_path + " is a folder, not an LCM log");
+  }
+  if (options.out_dir.empty()) throw ExportError("no output folder given");
+  if (options.camera_channel.empty()) throw ExportError("no camera channel given");
+  const fs::path out(options.out_dir);
+  checkOutputFolder(out);
+  const std::string info_channel =
+      options.info_channel.empty() ? options.camera_channel + "_INFO" : options.info_channel;
+
+  const Scan scan = scanLog(options, info_channel);
+  if (scan.camera_images == 0) {
+    std::string message = options.log_path + ": no image_t on channel " + options.camera_channel;
+    if (scan.camera_other_messages > 0) {
+      message +=
+          " (it carries " + plural(scan.camera_other_messages, "message") + " of another type)";
+    }
+    if (!scan.image_channels.empty()) {
+      message += "; channels with image_t: " + channelList(scan.image_channels, "image");
+    } else {
+      message += "; no channel in the log carries image_t";
+      if (!scan.all_channels.empty()) {
+        message += " (channels: " + channelList(scan.all_channels, "message") + ")";
+      }
+    }
+    throw ExportError(message);
+  }
+  if (!scan.calibration) {
+    std::string message = options.log_path + ": no camera_info_t on " + info_channel +
+                          " (the dataset's calibration comes from it)";
+    if (scan.undecodable.contains(info_channel)) {
+      message += "; " + plural(scan.undecodable.at(info_channel), "message") + " there " +
+                 "did not decode as a valid camera_info_t";
+    }
+    if (!scan.info_channels.empty()) {
+      message += "; channels with camera_info_t: " + channelList(scan.info_channels, "message");
+    }
+    throw ExportError(message);
+  }
+
+  createFolder(out);
+  ExportSummary summary;
+  summary.out_dir = options.out_dir;
+  summary.damage = scan.damage;
+  Context context{options, scan, *scan.calibration, out, {}, summary};
+  writeImages(context, layoutFor(options.format, out));
+  switch (options.format) {
+    case Format::kEuroc:
+      writeEuroc(context);
+      break;
+    case Format::kTumMono:
+      writeTumMono(context);
+      break;
+    case Format::kTum:
+      writeTum(context);
+      break;
+  }
+
+  auto& notes = summary.notes;
+  if (scan.calibration_changed_utime) {
+    notes.push_back("the camera_info_t on " + info_channel + " changed at utime " +
+                    std::to_string(*scan.calibration_changed_utime) +
+                    "; the export's calibration is the first one");
+  }
+  if (scan.truth.empty()) {
+    notes.push_back("no pose_t on " + options.truth_channel + ": no ground truth written");
+  }
+  if (scan.truth_duplicates > 0) {
+    notes.push_back(plural(scan.truth_duplicates, "pose_t") + " on " + options.truth_channel +
+                    " repeated an earlier time and were dropped");
+  }
+  if (scan.imu_duplicates > 0 && options.format == Format::kEuroc) {
+    notes.push_back(plural(scan.imu_duplicates, "imu_t") + " on " + options.imu_channel +
+                    " repeated an earlier time and were dropped");
+  }
+  for (const auto& [channel, count] : scan.undecodable) {
+    if (channel == info_channel && scan.calibration) continue;
+    notes.push_back(plural(count, "message") + " on " + channel +
+                    " did not decode (or held non-finite values) and were skipped");
+  }
+  return summary;
+}
+
+}  // namespace nadir::dataset

@@ -1,0 +1,417 @@
+// The per-run evaluation: robustness (tracked_pct), seed 000's metrics, a
+// source that never tracked, reading a log written with core's LcmLogWriter,
+// and the metrics.json round trip. Expected values are worked out by hand.
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/bus.h"
+#include "core/frames.h"
+#include "core/lcm_log.h"
+#include "logs/eval/run_metrics.h"
+#include "nadir/pose_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+
+namespace nadir::eval {
+namespace {
+
+std::string tempPath(const std::string& name) {
+  return ::testing::TempDir() + "nadir_eval_" + name;
+}
+
+// A straight truth along north at 10 m/s from 0 to 10 s, sampled at 100 Hz.
+PoseTrajectory straightTruth() {
+  PoseTrajectory truth;
+  for (int k = 0; k <= 1000; ++k) {
+    StampedPose pose;
+    pose.t_s = k * 0.01;
+    pose.p_m = Eigen::Vector3d(10.0 * pose.t_s, 0, -100);
+    truth.push_back(pose);
+  }
+  return truth;
+}
+
+// Estimates at 10 Hz from `from_s` to 9.9 s, exactly on the truth, with a status by time.
+template <typename StatusOf>
+std::vector<SourceEstimate> estimatesAt10Hz(int first_frame, StatusOf status_of) {
+  std::vector<SourceEstimate> estimates;
+  for (int k = first_frame; k < 100; ++k) {
+    SourceEstimate e;
+    e.t_s = k * 0.1;
+    e.status = status_of(k);
+    e.p_m = Eigen::Vector3d(10.0 * e.t_s, 0, -100);
+    estimates.push_back(e);
+  }
+  return estimates;
+}
+
+// LOST from 3.0 s to 5.0 s of a 10 s truth: 3 s + 5 s tracked = 80 %, in 2 segments.
+TEST(EvalRunMetrics, GapInTrackingGivesHandTrackedPct) {
+  const auto estimates = estimatesAt10Hz(0, [](int k) {
+    return k >= 30 && k < 50 ? SourceEstimate::kLost : SourceEstimate::kTracking;
+  });
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_NEAR(m.tracked_pct, 80.0, 1e-9);
+  EXPECT_TRUE(m.initialised);
+  EXPECT_EQ(m.tracking_segments, 2u);
+  EXPECT_EQ(m.estimates, 100u);
+  EXPECT_EQ(m.estimates_tracking, 80u);
+  EXPECT_EQ(m.estimates_evaluated, 80u);
+  EXPECT_NEAR(m.rate_hz, 10.0, 1e-9);
+  EXPECT_NEAR(m.position_rmse_m, 0.0, 1e-9);
+  // Track length within segments only: 0..2.9 s and 5.0..9.9 s at 10 m/s = 29 + 49 m.
+  EXPECT_NEAR(m.track_length_m, 78.0, 1e-9);
+  EXPECT_NEAR(m.truth_track_length_m, 78.0, 1e-9);
+  EXPECT_NEAR(m.rpe_translation_m.rmse, 0.0, 1e-9);
+  EXPECT_EQ(m.rpe_translation_m.count, 29u + 49u);  // pairs never straddle the gap
+}
+
+// Starting to track at 2.0 s counts the first 2 s as not tracked: 80 %.
+TEST(EvalRunMetrics, LateStartIsNotTracked) {
+  const auto estimates = estimatesAt10Hz(20, [](int) { return SourceEstimate::kTracking; });
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_NEAR(m.tracked_pct, 80.0, 1e-9);
+  EXPECT_NEAR(m.first_tracking_s, 2.0, 1e-9);
+}
+
+// A silent hole (no estimate 4.9..8.0 s) holds the last one 3 periods: 4.9 + 0.3 + 2.0 = 72 %.
+TEST(EvalRunMetrics, SilentHoleHoldsThreePeriods) {
+  auto estimates = estimatesAt10Hz(0, [](int) { return SourceEstimate::kTracking; });
+  estimates.erase(estimates.begin() + 50, estimates.begin() + 80);
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_NEAR(m.tracked_pct, 72.0, 1e-9);
+}
+
+// Seed 000 on three sides of a 100 m square against the same path scaled 0.9 about its start:
+// Path lengths sample every track_length_interval_s: a 200 Hz estimate that wobbles 1 cm
+// across a 10 m straight flight adds 200 x 2 cm of wobble at every estimate, none at 1 s.
+TEST(EvalRunMetrics, TrackLengthSamplesAtTheInterval) {
+  PoseTrajectory truth;
+  std::vector<SourceEstimate> estimates;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.005 * i;
+    truth.push_back({t, Eigen::Vector3d(10.0 * t, 0, 0), Eigen::Quaterniond::Identity()});
+    const double wobble = (i % 2 == 0 ? 0.01 : -0.01);
+    estimates.push_back(SourceEstimate{t, SourceEstimate::kTracking,
+                                       Eigen::Vector3d(10.0 * t, wobble, 0),
+                                       Eigen::Quaterniond::Identity()});
+  }
+  EvalOptions every;
+  every.track_length_interval_s = 0.0;
+  // Each 5 ms step: 0.05 m along, 0.02 m across: sqrt(0.05^2 + 0.02^2) = 0.053852 m.
+  EXPECT_NEAR(evaluateSource(truth, estimates, every).track_length_m, 200 * 0.0538516, 1e-4);
+  // At 1 s: the first and the last estimate, 10 m apart (both wobble +1 cm).
+  const SourceMetrics sampled = evaluateSource(truth, estimates, EvalOptions{});
+  EXPECT_NEAR(sampled.track_length_m, 10.0, 1e-9);
+  EXPECT_NEAR(sampled.truth_track_length_m, 10.0, 1e-9);
+}
+// length -10 %, end point 10 m = 3.333 % of 300 m, MAE (0 + 10 + 14.142 + 10) / 4.
+TEST(EvalRunMetrics, Seed000SquareVersusScaledSquare) {
+  const Eigen::Vector3d corners[4] = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}, {0, 100, 0}};
+  PoseTrajectory truth;
+  for (int k = 0; k <= 30; ++k) {  // 1 Hz, 10 m/s along the sides
+    const int side = std::min(k / 10, 2);
+    const double u = (k - 10.0 * side) / 10.0;
+    truth.push_back(StampedPose{static_cast<double>(k),
+                                corners[side] + u * (corners[side + 1] - corners[side]),
+                                Eigen::Quaterniond::Identity()});
+  }
+  std::vector<SourceEstimate> estimates;
+  for (int c = 0; c < 4; ++c) {
+    estimates.push_back(SourceEstimate{10.0 * c, SourceEstimate::kTracking, 0.9 * corners[c],
+                                       Eigen::Quaterniond::Identity()});
+  }
+  const SourceMetrics m = evaluateSource(truth, estimates, EvalOptions{});
+  EXPECT_NEAR(m.truth_track_length_m, 300.0, 1e-9);
+  EXPECT_NEAR(m.track_length_m, 270.0, 1e-9);
+  EXPECT_NEAR(m.track_length_diff_pct, -10.0, 1e-9);
+  EXPECT_NEAR(m.end_point_m, 10.0, 1e-9);
+  EXPECT_NEAR(m.end_point_pct, 100.0 * 10.0 / 300.0, 1e-9);
+  EXPECT_NEAR(m.mean_abs_error_m, (0 + 10 + std::sqrt(200.0) + 10) / 4, 1e-9);
+  EXPECT_NEAR(m.position_rmse_m, 10.0, 1e-9);  // sqrt((0 + 100 + 200 + 100) / 4)
+  EXPECT_NEAR(m.tracked_pct, 100.0, 1e-9);     // 10 s holds cover 0..30 s
+  EXPECT_NEAR(m.rate_hz, 0.1, 1e-12);
+  // APE with Sim(3) recovers the scale 1/0.9.
+  EvalOptions sim3;
+  sim3.align = "sim3";
+  const SourceMetrics aligned = evaluateSource(truth, estimates, sim3);
+  EXPECT_NEAR(aligned.alignment_scale, 1.0 / 0.9, 1e-9);
+  EXPECT_NEAR(aligned.ape_translation_m.rmse, 0.0, 1e-9);
+  EXPECT_EQ(aligned.alignment, "sim3");
+}
+
+// A source that only initialises: not initialised, 0 % tracked, metrics absent (NaN).
+TEST(EvalRunMetrics, NeverTrackedSourceHasNoMetrics) {
+  const auto estimates = estimatesAt10Hz(0, [](int) { return SourceEstimate::kInitializing; });
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_FALSE(m.initialised);
+  EXPECT_EQ(m.tracked_pct, 0.0);
+  EXPECT_TRUE(std::isnan(m.position_rmse_m));
+  EXPECT_TRUE(std::isnan(m.ape_translation_m.rmse));
+  EXPECT_EQ(m.ape_translation_m.count, 0u);
+  EXPECT_NEAR(m.rate_hz, 10.0, 1e-9);
+  EXPECT_EQ(m.note, "never tracked");
+}
+
+// A straight truth cannot fix an SE(3) alignment: APE and RPE are absent and the note says why.
+TEST(EvalRunMetrics, DegenerateAlignmentIsANote) {
+  const auto estimates = estimatesAt10Hz(0, [](int) { return SourceEstimate::kTracking; });
+  EvalOptions se3;
+  se3.align = "se3";
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, se3);
+  EXPECT_TRUE(std::isnan(m.ape_translation_m.rmse));
+  EXPECT_NEAR(m.position_rmse_m, 0.0, 1e-9);  // the thesis metrics need no alignment
+  EXPECT_NE(m.note.find("degenerate"), std::string::npos) << m.note;
+}
+
+// Estimates before the truth starts are skipped, not compared.
+TEST(EvalRunMetrics, EstimatesOutsideTruthAreSkipped) {
+  auto estimates = estimatesAt10Hz(0, [](int) { return SourceEstimate::kTracking; });
+  for (SourceEstimate& e : estimates) e.t_s -= 5.0;  // -5.0 .. 4.9 s
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_EQ(m.estimates_evaluated, 50u);
+  EXPECT_NEAR(m.tracked_pct, 50.0, 1e-9);
+  EXPECT_NE(m.note.find("50 TRACKING estimates outside"), std::string::npos) << m.note;
+}
+
+// ----------------------------------------------------------------- the log
+
+nadir::pose_t truthMessage(std::int64_t utime, const Eigen::Vector3d& p,
+                           const Eigen::Quaterniond& q) {
+  nadir::pose_t msg{};
+  msg.utime = utime;
+  for (int i = 0; i < 3; ++i) msg.pos[i] = p[i];
+  core::quaternionToWire(q, msg.orientation);
+  return msg;
+}
+
+nadir::vo_estimate_t estimateMessage(std::int64_t utime, const std::string& source, int status,
+                                     const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  nadir::vo_estimate_t msg{};
+  msg.utime = utime;
+  msg.source = source;
+  msg.status = static_cast<std::int8_t>(status);
+  msg.pose = truthMessage(utime, p, q);
+  if (status != SourceEstimate::kTracking) {
+    for (double& w : msg.pose.orientation) w = 0;  // not meaningful: must not be refused
+  }
+  return msg;
+}
+
+template <class Msg>
+void writeMessage(core::LcmLogWriter& writer, std::int64_t event_utime, const std::string& channel,
+                  const Msg& msg) {
+  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
+  writer.write(event_utime, channel, bytes.data(), bytes.size());
+}
+
+constexpr std::int64_t kStart = 1'700'000'000'000'000;  // UNIX-time utimes, as a live run
+
+// Truth 100 Hz for 2 s; vo_feature 10 Hz (2 INITIALIZING then TRACKING); one ppa; noise.
+std::string writeSampleLog(const std::string& name) {
+  const std::string path = tempPath(name);
+  core::LcmLogWriter writer(path);
+  const Eigen::Quaterniond yaw90(Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()));
+  for (int k = 0; k <= 200; ++k) {
+    const std::int64_t utime = kStart + k * 10'000;
+    // The event stamp differs from the message utime: the message's wins.
+    writeMessage(writer, utime + 777, "POSE_TRUTH",
+                 truthMessage(utime, Eigen::Vector3d(0.2 * k, 1, -50), yaw90));
+    if (k % 10 == 5) {
+      const int frame = k / 10;
+      writeMessage(
+          writer, utime + 777, "POSE_VO_FEATURE",
+          estimateMessage(utime, "vo_feature",
+                          frame < 2 ? SourceEstimate::kInitializing : SourceEstimate::kTracking,
+                          Eigen::Vector3d(0.2 * k + 1.0, 1, -50), yaw90));
+    }
+    if (k == 100) {
+      writeMessage(writer, utime, "POSE_PPA",
+                   estimateMessage(utime, "ppa", SourceEstimate::kLost, Eigen::Vector3d::Zero(),
+                                   Eigen::Quaterniond::Identity()));
+      const std::uint8_t garbage[5] = {1, 2, 3, 4, 5};
+      writer.write(utime, "POSE_TRUTH", garbage, sizeof garbage);
+      writer.write(utime, "IMU", garbage, sizeof garbage);
+    }
+  }
+  return path;
+}
+
+// readRunLog takes truth and estimates with their utimes, names sources by channel,
+// and reports the undecodable truth message as damage.
+TEST(EvalRunLog, ReadsTruthAndEstimatesFromLcmLogWriterLog) {
+  const LogTrajectories log = readRunLog(writeSampleLog("run.lcmlog"));
+  ASSERT_EQ(log.truth.size(), 201u);
+  EXPECT_DOUBLE_EQ(log.truth.front().t_s, 1'700'000'000.0);
+  EXPECT_NEAR(log.truth.back().t_s - log.truth.front().t_s, 2.0, 1e-6);
+  EXPECT_NEAR((log.truth[10].p_m - Eigen::Vector3d(2, 1, -50)).norm(), 0, 1e-12);
+  EXPECT_NEAR(core::rpyFromQuaternion(log.truth[10].q).yaw_rad, std::numbers::pi / 2, 1e-12);
+  ASSERT_EQ(log.sources.size(), 2u);
+  const auto& feature = log.sources.at("vo_feature");
+  ASSERT_EQ(feature.size(), 20u);
+  EXPECT_EQ(feature[0].status, SourceEstimate::kInitializing);
+  EXPECT_EQ(feature[2].status, SourceEstimate::kTracking);
+  EXPECT_NEAR(feature[2].t_s - log.truth.front().t_s, 0.25, 1e-6);
+  ASSERT_EQ(log.sources.at("ppa").size(), 1u);
+  EXPECT_EQ(log.sources.at("ppa")[0].status, SourceEstimate::kLost);
+  EXPECT_NE(log.damage.find("1 undecodable or invalid message on POSE_TRUTH"), std::string::npos)
+      << log.damage;
+
+  // Every TRACKING estimate is 1 m north of the truth.
+  const RunMetrics run = evaluate(log.truth, log.sources, EvalOptions{});
+  const SourceMetrics& m = run.sources.at("vo_feature");
+  EXPECT_NEAR(m.position_rmse_m, 1.0, 1e-6);
+  EXPECT_NEAR(m.rotation_rmse_deg, 0.0, 1e-6);
+  EXPECT_NEAR(m.tracked_pct, 100.0 * 1.75 / 2.0, 1e-6);  // TRACKING from 0.25 s to the end, 2.0 s
+  EXPECT_NEAR(run.truth_track_length_m, 40.0, 1e-9);
+  EXPECT_FALSE(run.sources.at("ppa").initialised);
+
+  // A custom channel map reads another channel set.
+  const LogTrajectories only_ppa = readRunLog(tempPath("run.lcmlog"), {{"POSE_PPA", "chip"}});
+  ASSERT_EQ(only_ppa.sources.size(), 1u);
+  EXPECT_EQ(only_ppa.sources.begin()->first, "chip");
+}
+
+// A truncated log gives what was read and the reader's damage report.
+TEST(EvalRunLog, TruncatedLogReportsDamage) {
+  const std::string path = writeSampleLog("truncated.lcmlog");
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 20);
+  const LogTrajectories log = readRunLog(path);
+  EXPECT_EQ(log.truth.size(), 200u);  // the last truth event was cut
+  EXPECT_FALSE(log.damage.empty());
+}
+
+// An empty log, a log without truth and a missing file are errors naming the file.
+TEST(EvalRunLog, EmptyOrTruthlessLogIsAnError) {
+  const std::string empty = tempPath("empty.lcmlog");
+  { core::LcmLogWriter writer(empty); }
+  try {
+    readRunLog(empty);
+    FAIL();
+  } catch (const EvalError& error) {
+    EXPECT_NE(std::string(error.what()).find(empty + ": the log is empty"), std::string::npos)
+        << error.what();
+  }
+  const std::string no_truth = tempPath("no_truth.lcmlog");
+  {
+    core::LcmLogWriter writer(no_truth);
+    writeMessage(writer, kStart, "POSE_PPA",
+                 estimateMessage(kStart, "ppa", SourceEstimate::kLost, Eigen::Vector3d::Zero(),
+                                 Eigen::Quaterniond::Identity()));
+  }
+  try {
+    readRunLog(no_truth);
+    FAIL();
+  } catch (const EvalError& error) {
+    EXPECT_NE(std::string(error.what()).find("no truth"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(readRunLog(tempPath("does_not_exist.lcmlog")), EvalError);
+}
+
+// ------------------------------------------------------------ metrics.json
+
+void expectSame(double a, double b) {
+  if (std::isnan(a)) {
+    EXPECT_TRUE(std::isnan(b));
+  } else {
+    EXPECT_EQ(a, b);
+  }
+}
+
+void expectSame(const Statistics& a, const Statistics& b) {
+  expectSame(a.rmse, b.rmse);
+  expectSame(a.mean, b.mean);
+  expectSame(a.median, b.median);
+  expectSame(a.std, b.std);
+  expectSame(a.min, b.min);
+  expectSame(a.max, b.max);
+  EXPECT_EQ(a.count, b.count);
+}
+
+// write -> read gives the same numbers; a never-tracked source is null, never NaN, in the file.
+TEST(EvalMetricsJson, RoundTrip) {
+  std::map<std::string, std::vector<SourceEstimate>> sources;
+  sources["vo_feature"] = estimatesAt10Hz(0, [](int k) {
+    return k >= 30 && k < 50 ? SourceEstimate::kLost : SourceEstimate::kTracking;
+  });
+  for (SourceEstimate& e : sources["vo_feature"]) e.p_m.y() += 0.1 * std::sin(e.t_s);
+  sources["vo_direct"] = estimatesAt10Hz(0, [](int) { return SourceEstimate::kInitializing; });
+  EvalOptions options;
+  options.align = "none";
+  options.rpe_delta = 2.0;
+  options.rpe_delta_unit = "meters";
+  const RunMetrics written = evaluate(straightTruth(), sources, options);
+  const std::string path = tempPath("metrics.json");
+  writeMetricsJson(path, written, options);
+
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  EXPECT_EQ(text.str().find("NaN"), std::string::npos);
+  EXPECT_EQ(text.str().find("nan"), std::string::npos);
+  EXPECT_NE(text.str().find("\"initialised\": false"), std::string::npos);
+  EXPECT_NE(text.str().find("\"position_rmse_m\": null"), std::string::npos);
+
+  EvalOptions read_options;
+  const RunMetrics read = readMetricsJson(path, &read_options);
+  EXPECT_EQ(read_options.align, "none");
+  EXPECT_EQ(read_options.rpe_delta_unit, "meters");
+  EXPECT_EQ(read.truth_track_length_m, written.truth_track_length_m);
+  EXPECT_EQ(read.truth_duration_s, written.truth_duration_s);
+  EXPECT_EQ(read.truth_poses, written.truth_poses);
+  ASSERT_EQ(read.sources.size(), 2u);
+  for (const auto& [name, w] : written.sources) {
+    SCOPED_TRACE(name);
+    const SourceMetrics& r = read.sources.at(name);
+    EXPECT_EQ(r.initialised, w.initialised);
+    expectSame(r.position_rmse_m, w.position_rmse_m);
+    expectSame(r.rotation_rmse_deg, w.rotation_rmse_deg);
+    expectSame(r.tracked_pct, w.tracked_pct);
+    expectSame(r.track_length_diff_pct, w.track_length_diff_pct);
+    expectSame(r.mean_abs_error_m, w.mean_abs_error_m);
+    expectSame(r.end_point_m, w.end_point_m);
+    expectSame(r.end_point_pct, w.end_point_pct);
+    expectSame(r.rate_hz, w.rate_hz);
+    expectSame(r.first_tracking_s, w.first_tracking_s);
+    expectSame(r.alignment_scale, w.alignment_scale);
+    EXPECT_EQ(r.alignment, w.alignment);
+    EXPECT_EQ(r.rpe_delta, w.rpe_delta);
+    EXPECT_EQ(r.rpe_delta_unit, w.rpe_delta_unit);
+    EXPECT_EQ(r.estimates_evaluated, w.estimates_evaluated);
+    EXPECT_EQ(r.tracking_segments, w.tracking_segments);
+    EXPECT_EQ(r.note, w.note);
+    expectSame(r.ape_translation_m, w.ape_translation_m);
+    expectSame(r.ape_rotation_deg, w.ape_rotation_deg);
+    expectSame(r.rpe_translation_m, w.rpe_translation_m);
+    expectSame(r.rpe_rotation_deg, w.rpe_rotation_deg);
+  }
+  EXPECT_GT(read.sources.at("vo_feature").rpe_translation_m.count, 0u);
+
+  // The table has one row per source and "-" for what does not exist.
+  const std::string table = formatResultsTable(read);
+  EXPECT_NE(table.find("vo_direct"), std::string::npos);
+  EXPECT_NE(table.find("vo_feature"), std::string::npos);
+}
+
+// A damaged metrics.json is refused with the file and the key.
+TEST(EvalMetricsJson, MissingKeyIsNamed) {
+  const std::string path = tempPath("bad_metrics.json");
+  std::ofstream(path) << R"({"schema": "nadir.metrics", "version": 1, "truth": {"duration_s": 1}})";
+  try {
+    readMetricsJson(path);
+    FAIL();
+  } catch (const EvalError& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ": truth: missing key 'track_length_m'"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace nadir::eval
