@@ -18,7 +18,7 @@
 #include "core/bus.h"
 #include "core/clock.h"
 #include "core/frames.h"
-#include "nodes/camera/camera_messages.h"
+#include "lcmtypes/codec.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
 #include "terrain/procedural_world.h"
@@ -55,9 +55,12 @@ int main(int argc, char** argv) {
   app.add_option("--agl", agl_m, "height above ground, m")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "procedural world seed");
   nadir::terrain::TileParams tile_params;
-  app.add_option("--texture-px", tile_params.texture_px, "tile texture size, px")->capture_default_str();
-  app.add_option("--mesh-quads", tile_params.mesh_quads, "mesh quads along a tile edge")->capture_default_str();
-  app.add_option("--max-texel-px", tile_params.max_texel_px, "refine while a texel covers more pixels")
+  app.add_option("--texture-px", tile_params.texture_px, "tile texture size, px")
+      ->capture_default_str();
+  app.add_option("--mesh-quads", tile_params.mesh_quads, "mesh quads along a tile edge")
+      ->capture_default_str();
+  app.add_option("--max-texel-px", tile_params.max_texel_px,
+                 "refine while a texel covers more pixels")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -73,8 +76,8 @@ int main(int argc, char** argv) {
       seconds, speed_mps, agl_m, static_cast<long long>(seed), world_params.size_m / 1000.0);
   std::printf("tiles: %d px textures, %d mesh quads, refine above %.2f px per texel\n",
               tile_params.texture_px, tile_params.mesh_quads, tile_params.max_texel_px);
-  std::printf("%-26s %8s %9s %9s %9s %8s %9s %8s %9s\n", "camera", "frames", "frames/s", "median ms",
-              "p95 ms", "tiles", "triangles", "made", "RSS MiB");
+  std::printf("%-26s %8s %9s %9s %9s %8s %9s %8s %9s\n", "camera", "frames", "frames/s",
+              "median ms", "p95 ms", "tiles", "triangles", "made", "RSS MiB");
 
   const Case cases[] = {{"1280x960 gray8 84.9 deg", 1280, 960, 84.872, 31.0, "gray8"},
                         {"256x256 gray8 50 deg", 256, 256, 50.0, 200.0, "gray8"},
@@ -107,7 +110,7 @@ int main(int argc, char** argv) {
       const nadir::render::RenderedImage image =
           camera.render(T_world_cam, nadir::core::utimeFromSeconds(t_s));
       const std::vector<std::uint8_t> bytes =
-          nadir::core::encodeMessage(nadir::camera::toImageMessage(image, 0));
+          nadir::msg::encode(nadir::msg::Image{image.utime, image.image, 0, {}});
       frame_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frame_start)
               .count());

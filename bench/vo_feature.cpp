@@ -29,11 +29,10 @@
 
 #include "core/bus.h"
 #include "core/lcm_log.h"
+#include "lcmtypes/bus_io.h"
 #include "logs/eval/run_metrics.h"
-#include "nadir/image_t.hpp"
-#include "nodes/camera/camera_messages.h"
-#include "nodes/vo_feature/vo_feature_node.h"
 #include "nodes/scenario.h"
+#include "nodes/vo_feature/vo_feature_node.h"
 
 namespace {
 
@@ -98,13 +97,13 @@ int main(int argc, char** argv) {
     nadir::vo::VoFeatureNode node(*bus, params);
     std::optional<std::int64_t> first_image_utime;
     bool debug_written = false;
-    nadir::core::Subscription debug_subscription = nadir::core::subscribe<nadir::image_t>(
-        *bus, params.debug_channel, [&](const nadir::image_t& image) {
+    nadir::core::Subscription debug_subscription = nadir::msg::subscribe<nadir::msg::Image>(
+        *bus, params.debug_channel, [&](const nadir::msg::Image& image) {
           if (debug_png.empty() || debug_written || !first_image_utime) return;
           if (image.utime < *first_image_utime + static_cast<std::int64_t>(debug_at_s * 1e6))
             return;
           cv::Mat bgr;
-          cv::cvtColor(nadir::camera::imageFromMessage(image), bgr, cv::COLOR_RGB2BGR);
+          cv::cvtColor(image.pixels, bgr, cv::COLOR_RGB2BGR);
           cv::imwrite(debug_png, bgr);
           debug_written = true;
         });

@@ -44,8 +44,8 @@ void evaluateRun(const EvalCommandOptions& options) {
 }
 
 void evaluateTumPair(const EvalCommandOptions& options) {
-  const eval::PoseTrajectory ref = eval::readTum(options.ref);
-  const eval::PoseTrajectory est = eval::readTum(options.est);
+  const core::Trajectory ref = core::readTum(options.ref);
+  const core::Trajectory est = core::readTum(options.est);
   eval::TrajectoryEvaluation evaluation;
   try {
     evaluation = eval::evaluateTrajectories(ref, est, options.eval);

@@ -140,46 +140,8 @@ std::unique_ptr<Bus> openBus(const BusParams& params);
 // The URL an empty url resolves to here.
 std::string defaultBusUrl();
 
-// ---- typed helpers over lcm-gen types (no lcm-cpp.hpp needed) ----
-
-template <class Msg>
-std::vector<std::uint8_t> encodeMessage(const Msg& msg) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  if (msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0) {
-    throw BusError(std::string("cannot encode ") + Msg::getTypeName());
-  }
-  return bytes;
-}
-
-// Decodes bytes into msg; false if they are not a whole Msg (wrong type, truncated).
-template <class Msg>
-bool decodeMessage(const void* data, std::size_t size, Msg& msg) {
-  return msg.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size);
-}
-
 // Every nadir message starts with int64 utime right after LCM's 8-byte
 // fingerprint; this reads it without knowing the type (nothing if too short).
 std::optional<std::int64_t> peekUtime(const RawMessage& message);
-
-template <class Msg>
-void publish(Bus& bus, std::string_view channel, const Msg& msg) {
-  const std::vector<std::uint8_t> bytes = encodeMessage(msg);
-  bus.publish(channel, bytes.data(), bytes.size(), msg.utime);
-}
-
-// Subscribes with decoding. A message that does not decode as Msg is dropped
-// and counted in stats().decode_errors; the handler never sees it.
-template <class Msg>
-Subscription subscribe(Bus& bus, const std::string& channel_regex,
-                       std::function<void(const Msg&)> handler) {
-  return bus.subscribe(channel_regex, [&bus, handler = std::move(handler)](const RawMessage& raw) {
-    Msg msg;
-    if (!decodeMessage(raw.data, raw.size, msg)) {
-      bus.countDecodeError(raw.channel);
-      return;
-    }
-    handler(msg);
-  });
-}
 
 }  // namespace nadir::core

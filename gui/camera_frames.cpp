@@ -8,23 +8,25 @@
 
 #include "core/bus.h"
 #include "core/lcm_log.h"
-#include "nadir/image_t.hpp"
-#include "nodes/camera/camera_messages.h"
+#include "core/trajectory.h"
+#include "lcmtypes/codec.h"
 
 namespace nadir::gui {
 
 CameraFrame decodeCameraFrame(const void* data, std::size_t size, std::int64_t number) {
   CameraFrame frame;
   frame.number = number;
-  nadir::image_t message;
-  if (!core::decodeMessage(data, size, message)) {
-    frame.error = "not an image_t (" + std::to_string(size) + " bytes)";
-    return frame;
-  }
-  frame.t_s = static_cast<double>(message.utime) / 1e6;
   try {
-    frame.pixels = camera::imageFromMessage(message);
-  } catch (const std::exception& e) {
+    const msg::Image image = msg::decode<msg::Image>(data, size);
+    frame.t_s = core::stampFromUtime(image.utime);
+    frame.pixels = image.pixels;
+  } catch (const msg::DecodeError& e) {
+    frame.error = "not an image_t (" + std::to_string(size) + " bytes)";
+  } catch (const msg::InvalidMessage& e) {
+    if (const std::optional<std::int64_t> utime = core::peekUtime(
+            core::RawMessage{{}, static_cast<const std::uint8_t*>(data), size, 0})) {
+      frame.t_s = core::stampFromUtime(*utime);
+    }
     frame.error = e.what();
   }
   return frame;
@@ -43,7 +45,7 @@ LogCameraFrames::LogCameraFrames(const std::string& log_path, const std::string&
     raw.channel = event->channel;
     raw.data = event->data.data();
     raw.size = event->data.size();
-    stamps_s.push_back(static_cast<double>(core::peekUtime(raw).value_or(0)) / 1e6);
+    stamps_s.push_back(core::stampFromUtime(core::peekUtime(raw).value_or(0)));
     offsets.push_back(event->offset);
   }
   std::vector<std::size_t> order(stamps_s.size());

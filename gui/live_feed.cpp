@@ -3,43 +3,42 @@
 #include <algorithm>
 #include <utility>
 
+#include "lcmtypes/codec.h"
+
 namespace nadir::gui {
 
 LiveFeed::LiveFeed(core::Bus& bus, LiveFeedParams params)
-    : collector_(params.source_channels), bus_(bus), params_(std::move(params)) {
+    : collector_(params.truth_channel), bus_(bus), params_(std::move(params)) {
   if (!params_.camera_channel.empty()) {
     frames_ =
         std::make_unique<RecentCameraFrames>(params_.camera_channel, params_.image_budget_bytes);
   }
-  subscriptions_.push_back(
-      bus_.subscribe(eval::kTruthChannel, [this](const core::RawMessage& message) {
-        const std::optional<std::int64_t> utime = core::peekUtime(message);
-        if (utime) {
-          const double t_s = static_cast<double>(*utime) / 1e6;
-          if (t_s < newest_truth_s_ - kRestartJump_s) restart();
-          newest_truth_s_ = std::max(newest_truth_s_, t_s);
-        }
-        take(message);
-      }));
-  for (const auto& [channel, name] : params_.source_channels) {
-    subscriptions_.push_back(
-        bus_.subscribe(channel, [this](const core::RawMessage& message) { take(message); }));
-  }
-  if (frames_) {
-    subscriptions_.push_back(
-        bus_.subscribe(params_.camera_channel, [this](const core::RawMessage& message) {
-          frames_->add(message.data, message.size);
-          ++version_;
-        }));
-  }
+  subscriptions_.push_back(bus_.subscribe(".*", [this](const core::RawMessage& message) {
+    if (frames_ && message.channel == params_.camera_channel) {
+      frames_->add(message.data, message.size);
+      ++version_;
+      return;
+    }
+    take(message);
+  }));
 }
 
 void LiveFeed::take(const core::RawMessage& message) {
+  const bool truth = params_.truth_channel.empty()
+                         ? msg::isType<msg::Pose>(message.data, message.size)
+                         : message.channel == params_.truth_channel;
+  if (truth) {
+    if (const std::optional<std::int64_t> utime = core::peekUtime(message)) {
+      const double t_s = core::stampFromUtime(*utime);
+      if (t_s < newest_truth_s_ - kRestartJump_s) restart();
+      newest_truth_s_ = std::max(newest_truth_s_, t_s);
+    }
+  }
   if (collector_.add(std::string(message.channel), message.data, message.size)) ++version_;
 }
 
 void LiveFeed::restart() {
-  collector_ = eval::TrajectoryCollector(params_.source_channels);
+  collector_ = logs::TrajectoryCollector(params_.truth_channel);
   if (frames_) {
     frames_ =
         std::make_unique<RecentCameraFrames>(params_.camera_channel, params_.image_budget_bytes);

@@ -14,15 +14,17 @@
 #include <vector>
 
 #include "core/bus.h"
-#include "logs/eval/run_metrics.h"
 #include "gui/camera_frames.h"
 #include "gui/run_data.h"
+#include "logs/run_log.h"
 
 namespace nadir::gui {
 
 struct LiveFeedParams {
   std::string camera_channel = kDefaultCameraChannel;  // empty: no images
-  std::map<std::string, std::string> source_channels = eval::defaultSourceChannels();
+  // The truth's pose_t channel; empty: the channel that carries pose_t. The
+  // estimates are every vo_estimate_t, named by their source.
+  std::string truth_channel;
   // Pixels of recent images kept for seeking back, bytes.
   std::size_t image_budget_bytes = std::size_t{256} << 20;
 };
@@ -56,7 +58,7 @@ class LiveFeed {
   void take(const core::RawMessage& message);
   void restart();
 
-  eval::TrajectoryCollector collector_;
+  logs::TrajectoryCollector collector_;
   std::unique_ptr<RecentCameraFrames> frames_;
   core::Bus& bus_;
   std::vector<core::Subscription> subscriptions_;

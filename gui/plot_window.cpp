@@ -524,7 +524,7 @@ void PlotWindow::refreshLive() {
     return;
   }
   if (!live) {
-    fail(QStringLiteral("live: waiting for the truth on %1").arg(eval::kTruthChannel));
+    fail(QStringLiteral("live: waiting for the truth (pose_t)"));
     return;
   }
   // The metrics once, against the truth shown.
@@ -546,9 +546,8 @@ void PlotWindow::refreshLive() {
   }
   QString status = QStringLiteral("live: %1 truth poses").arg(run_->truth.size());
   for (const auto& [name, source] : run_->sources) {
-    status += QStringLiteral(", %1 %2 estimates")
-                  .arg(QString::fromStdString(name))
-                  .arg(source.pose.size());
+    status +=
+        QStringLiteral(", %1 %2 estimates").arg(QString::fromStdString(name)).arg(source.size());
   }
   if (!metrics_note_.empty()) {
     status += QStringLiteral("; no metrics yet: ") + QString::fromStdString(metrics_note_);

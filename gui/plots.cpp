@@ -16,27 +16,38 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <memory>
 #include <utility>
 
 namespace nadir::gui {
 
 QColor sourceColor(const RunData& run, const std::string& name) {
-  // Known sources keep their colour across runs; others take the rest in order.
-  if (name == "ppa") return QColor(0x1f, 0x77, 0xb4);
-  if (name == "vo_feature") return QColor(0xff, 0x7f, 0x0e);
-  if (name == "vo_direct") return QColor(0x2c, 0xa0, 0x2c);
-  static const QColor kOthers[] = {QColor(0x94, 0x67, 0xbd), QColor(0x8c, 0x56, 0x4b),
-                                   QColor(0xe3, 0x77, 0xc2), QColor(0x17, 0xbe, 0xcf),
-                                   QColor(0xbc, 0xbd, 0x22), QColor(0x7f, 0x7f, 0x7f)};
-  std::size_t index = 0;
+  // A colour from the name's hash, so a source keeps it in every run and chart;
+  // one already taken in this run by a source earlier by name moves to the next.
+  // (The order puts ppa on blue, vo_feature on orange and vo_direct on green; no
+  // grey, which the axes and labels use.)
+  static const QColor kPalette[] = {QColor(0x94, 0x67, 0xbd), QColor(0x8c, 0x56, 0x4b),
+                                    QColor(0xe3, 0x77, 0xc2), QColor(0xff, 0x7f, 0x0e),
+                                    QColor(0x1f, 0x77, 0xb4), QColor(0x17, 0xbe, 0xcf),
+                                    QColor(0x2c, 0xa0, 0x2c), QColor(0xbc, 0xbd, 0x22)};
+  constexpr std::size_t kColors = std::size(kPalette);
+  const auto hashed = [](const std::string& text) {
+    std::uint64_t hash = 0xcbf29ce484222325ULL;  // FNV-1a: the same on every platform
+    for (const unsigned char c : text) hash = (hash ^ c) * 0x100000001b3ULL;
+    return static_cast<std::size_t>(hash % kColors);
+  };
+  std::vector<bool> taken(kColors, false);
   for (const auto& [other, series] : run.sources) {
-    if (other == name) break;
-    if (other != "ppa" && other != "vo_feature" && other != "vo_direct") ++index;
+    std::size_t index = hashed(other);
+    for (std::size_t k = 0; k < kColors && taken[index]; ++k) index = (index + 1) % kColors;
+    if (other == name) return kPalette[index];
+    taken[index] = true;
   }
-  return kOthers[index % std::size(kOthers)];
+  return kPalette[hashed(name)];
 }
 
 QString truthLabel(const RunData& run) {
@@ -202,7 +213,7 @@ QString runName(const RunData& run) {
   return QString::fromStdString(path.filename().string());
 }
 
-using Field = std::vector<double> PoseSeries::*;
+using Field = std::vector<double> FigureColumns::*;
 
 // One chart per field of the pose, truth and every source on each.
 Figure timeFigure(const RunData& run, const HiddenTrajectories& hidden, const std::string& name,
@@ -210,18 +221,21 @@ Figure timeFigure(const RunData& run, const HiddenTrajectories& hidden, const st
                   bool angles) {
   Figure figure;
   figure.name = name;
-  const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
+  const FigureColumns truth = figureColumns(run.truth);
+  std::map<std::string, FigureColumns> sources;
+  for (const auto& [source, series] : run.sources) sources[source] = figureColumns(series);
+  const std::vector<double> truth_t = sinceStart(truth.t_s, run.t0_s);
   for (std::size_t k = 0; k < fields.size(); ++k) {
     const auto& [field, label] = fields[k];
     ChartBuilder chart(k == 0 ? title + ": " + runName(run) : QString(), "time (s)", label);
     if (!hidden.contains(run.truth_name)) {
-      chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, truth_t, run.truth.*field, angles);
+      chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, truth_t, truth.*field, angles);
     }
-    for (const auto& [source, series] : run.sources) {
+    for (const auto& [source, columns] : sources) {
       if (hidden.contains(source)) continue;
-      const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
-      chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
-                    series.pose.*field, angles);
+      const std::vector<double> t = sinceStart(columns.t_s, run.t0_s);
+      chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t, columns.*field,
+                    angles);
     }
     figure.charts.push_back(chart.take());
   }
@@ -324,17 +338,17 @@ void keepRoundTicks(QChart* chart, QValueAxis* axis) {
 
 Figure positionFigure(const RunData& run, const HiddenTrajectories& hidden) {
   return timeFigure(run, hidden, "position", "Position (world NED)",
-                    {{&PoseSeries::x_m, "north x (m)"},
-                     {&PoseSeries::y_m, "east y (m)"},
-                     {&PoseSeries::z_m, "down z (m)"}},
+                    {{&FigureColumns::x_m, "north x (m)"},
+                     {&FigureColumns::y_m, "east y (m)"},
+                     {&FigureColumns::z_m, "down z (m)"}},
                     false);
 }
 
 Figure attitudeFigure(const RunData& run, const HiddenTrajectories& hidden) {
   return timeFigure(run, hidden, "attitude", "Attitude (Z-Y-X)",
-                    {{&PoseSeries::roll_deg, "roll (deg)"},
-                     {&PoseSeries::pitch_deg, "pitch (deg)"},
-                     {&PoseSeries::yaw_deg, "yaw (deg)"}},
+                    {{&FigureColumns::roll_deg, "roll (deg)"},
+                     {&FigureColumns::pitch_deg, "pitch (deg)"},
+                     {&FigureColumns::yaw_deg, "yaw (deg)"}},
                     true);
 }
 
@@ -344,7 +358,7 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
   ChartBuilder chart("Position error: " + runName(run), "time (s)", "|p_est - p_truth| (m)");
   for (const auto& [source, series] : run.sources) {
     if (hidden.contains(source)) continue;
-    const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
+    const std::vector<double> t = sinceStart(figureColumns(series).t_s, run.t0_s);
     chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
                   series.position_error_m);
   }
@@ -360,15 +374,17 @@ Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden) {
   Figure figure;
   figure.name = "top_view";
   ChartBuilder chart("Top view: " + runName(run), "east y (m)", "north x (m)");
-  const std::vector<double> truth_t = sinceStart(run.truth.t_s, run.t0_s);
+  const FigureColumns truth = figureColumns(run.truth);
+  const std::vector<double> truth_t = sinceStart(truth.t_s, run.t0_s);
   if (!hidden.contains(run.truth_name)) {
-    chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, run.truth.y_m, run.truth.x_m);
+    chart.addLine(truthLabel(run), kTruthColor, 2.0, truth_t, truth.y_m, truth.x_m);
   }
   for (const auto& [source, series] : run.sources) {
     if (hidden.contains(source)) continue;
-    const std::vector<double> t = sinceStart(series.pose.t_s, run.t0_s);
-    chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, series.pose.y_m,
-                  series.pose.x_m);
+    const FigureColumns columns = figureColumns(series);
+    const std::vector<double> t = sinceStart(columns.t_s, run.t0_s);
+    chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, columns.y_m,
+                  columns.x_m);
   }
   const Range x = chart.xRange();
   const Range y = chart.yRange();

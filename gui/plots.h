@@ -1,7 +1,7 @@
 #pragma once
 // The plot viewer's charts of a run (Qt Charts), shared by the headless renderer
 // and the interactive viewer. Truth is always black, each source keeps its own
-// colour in every chart (ppa, vo_feature and vo_direct the same in every run).
+// colour in every chart and, by its name, in every run.
 // Time axes show seconds since the truth's first pose.
 
 #include <QChart>

@@ -14,7 +14,6 @@
 #include <utility>
 
 #include "core/frames.h"
-#include "logs/eval/trajectory.h"
 
 namespace nadir::gui {
 namespace {
@@ -34,81 +33,77 @@ bool isFile(const fs::path& path) {
   return fs::is_regular_file(path, error);
 }
 
-void appendPose(PoseSeries& series, double t_s, const Eigen::Vector3d& p_m,
-                const Eigen::Quaterniond& q) {
-  const core::RollPitchYaw rpy = core::rpyFromQuaternion(q);
-  series.t_s.push_back(t_s);
-  series.x_m.push_back(p_m.x());
-  series.y_m.push_back(p_m.y());
-  series.z_m.push_back(p_m.z());
-  series.roll_deg.push_back(rpy.roll_rad * kDegPerRad);
-  series.pitch_deg.push_back(rpy.pitch_rad * kDegPerRad);
-  series.yaw_deg.push_back(rpy.yaw_rad * kDegPerRad);
+void appendPose(FigureColumns& columns, const core::StampedPose& pose, double yaw_near_rad) {
+  const core::RollPitchYaw rpy = core::rpyFromQuaternion(pose.q_world_body);
+  columns.t_s.push_back(pose.t_s);
+  columns.x_m.push_back(pose.p_ned_m.x());
+  columns.y_m.push_back(pose.p_ned_m.y());
+  columns.z_m.push_back(pose.p_ned_m.z());
+  columns.roll_deg.push_back(rpy.roll_rad * kDegPerRad);
+  columns.pitch_deg.push_back(rpy.pitch_rad * kDegPerRad);
+  double yaw_deg = rpy.yaw_rad * kDegPerRad;
+  if (std::isfinite(yaw_near_rad)) {
+    yaw_deg += 360.0 * std::round((yaw_near_rad * kDegPerRad - yaw_deg) / 360.0);
+  }
+  columns.yaw_deg.push_back(yaw_deg);
 }
 
-void appendEmpty(PoseSeries& series, double t_s) {
-  series.t_s.push_back(t_s);
-  for (std::vector<double>* v : {&series.x_m, &series.y_m, &series.z_m, &series.roll_deg,
-                                 &series.pitch_deg, &series.yaw_deg}) {
+void appendEmpty(FigureColumns& columns, double t_s) {
+  columns.t_s.push_back(t_s);
+  for (std::vector<double>* v : {&columns.x_m, &columns.y_m, &columns.z_m, &columns.roll_deg,
+                                 &columns.pitch_deg, &columns.yaw_deg}) {
     v->push_back(kNaN);
   }
 }
 
-SourceSeries sourceSeries(const eval::PoseTrajectory& truth,
-                          const std::vector<eval::SourceEstimate>& estimates,
+SourceSeries sourceSeries(const core::Trajectory& truth,
+                          const std::vector<logs::SourceEstimate>& estimates,
                           double truth_max_gap_s) {
   SourceSeries series;
-  for (const eval::SourceEstimate& e : estimates) {
-    series.status.push_back(e.status);
-    if (e.status != eval::SourceEstimate::kTracking) {
-      appendEmpty(series.pose, e.t_s);
+  series.estimates = estimates;
+  bool in_stretch = false;
+  for (const logs::SourceEstimate& e : estimates) {
+    if (e.status != logs::SourceEstimate::kTracking) {
       series.position_error_m.push_back(kNaN);
+      series.truth_yaw_rad.push_back(kNaN);
+      in_stretch = false;
       continue;
     }
-    appendPose(series.pose, e.t_s, e.p_m, e.q);
-    const std::optional<eval::StampedPose> reference =
-        eval::interpolate(truth, e.t_s, truth_max_gap_s);
-    series.position_error_m.push_back(reference ? (e.p_m - reference->p_m).norm() : kNaN);
-    if (reference) {
-      // The yaw on the truth's side of +-180 deg, so that a heading near south is
-      // drawn beside the truth's rather than a full turn away.
-      const double truth_yaw_deg = core::rpyFromQuaternion(reference->q).yaw_rad * kDegPerRad;
-      double& yaw_deg = series.pose.yaw_deg.back();
-      yaw_deg += 360.0 * std::round((truth_yaw_deg - yaw_deg) / 360.0);
-    }
+    if (!in_stretch) series.tracked.emplace_back();
+    in_stretch = true;
+    series.tracked.back().push_back(e);
+    const std::optional<core::StampedPose> reference =
+        core::interpolate(truth, e.t_s, truth_max_gap_s);
+    series.position_error_m.push_back(reference ? (e.p_ned_m - reference->p_ned_m).norm() : kNaN);
+    series.truth_yaw_rad.push_back(
+        reference ? core::rpyFromQuaternion(reference->q_world_body).yaw_rad : kNaN);
   }
   return series;
 }
 
-std::vector<eval::SourceEstimate> trackingEstimates(const eval::PoseTrajectory& trajectory) {
-  std::vector<eval::SourceEstimate> estimates;
+std::vector<logs::SourceEstimate> trackingEstimates(const core::Trajectory& trajectory) {
+  std::vector<logs::SourceEstimate> estimates;
   estimates.reserve(trajectory.size());
-  for (const eval::StampedPose& pose : trajectory) {
-    estimates.push_back({pose.t_s, eval::SourceEstimate::kTracking, pose.p_m, pose.q});
+  for (const core::StampedPose& pose : trajectory) {
+    estimates.push_back({pose, logs::SourceEstimate::kTracking});
   }
   return estimates;
 }
 
 // The TRACKING poses of a trajectory in stamp order, the first of equal stamps
 // kept, the poses as they are (a recorded truth goes through unchanged).
-eval::PoseTrajectory truthOf(std::vector<eval::SourceEstimate> estimates) {
+core::Trajectory truthOf(std::vector<logs::SourceEstimate> estimates) {
   std::stable_sort(
       estimates.begin(), estimates.end(),
-      [](const eval::SourceEstimate& a, const eval::SourceEstimate& b) { return a.t_s < b.t_s; });
-  eval::PoseTrajectory truth;
+      [](const logs::SourceEstimate& a, const logs::SourceEstimate& b) { return a.t_s < b.t_s; });
+  core::Trajectory truth;
   truth.reserve(estimates.size());
-  for (const eval::SourceEstimate& e : estimates) {
-    if (e.status != eval::SourceEstimate::kTracking) continue;
+  for (const logs::SourceEstimate& e : estimates) {
+    if (e.status != logs::SourceEstimate::kTracking) continue;
     if (!truth.empty() && e.t_s <= truth.back().t_s) continue;
-    truth.push_back({e.t_s, e.p_m, e.q});
+    truth.push_back(e);
   }
   return truth;
-}
-
-eval::PoseTrajectory readTumFile(const fs::path& path) {
-  eval::PoseTrajectory trajectory = eval::readTum(path.string());
-  if (trajectory.empty()) throw RunDataError(path.string() + ": no pose in the file");
-  return trajectory;
 }
 
 std::vector<fs::path> tumFiles(const fs::path& dir) {
@@ -159,7 +154,7 @@ std::vector<std::string> namesOf(const RunTrajectories& read) {
 }
 
 // The run's metrics against truth, its truth's poses as truthOf gives them.
-void setMetrics(RunData& run, const eval::PoseTrajectory& truth) {
+void setMetrics(RunData& run, const core::Trajectory& truth) {
   const RunTrajectories& read = *run.trajectories;
   run.metrics = {};
   run.metrics_from.clear();
@@ -168,7 +163,7 @@ void setMetrics(RunData& run, const eval::PoseTrajectory& truth) {
     run.metrics_from = read.metrics_file;
     return;
   }
-  std::map<std::string, std::vector<eval::SourceEstimate>> others;
+  std::map<std::string, std::vector<logs::SourceEstimate>> others;
   for (const auto& [name, estimates] : read.by_name) {
     if (name != run.truth_name) others.emplace(name, estimates);
   }
@@ -189,7 +184,7 @@ RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> 
     throw RunDataError(dir + ": no trajectory " + truth_name + " (it has " +
                        joined(namesOf(*read)) + ")");
   }
-  const eval::PoseTrajectory truth = truthOf(chosen->second);
+  const core::Trajectory truth = truthOf(chosen->second);
   if (truth.empty()) throw RunDataError(dir + ": " + truth_name + " has no tracked pose");
   RunData run;
   run.dir = dir;
@@ -199,7 +194,7 @@ RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> 
   if (truth_name == read->recorded_truth) run.truth_note = read->recorded_truth_note;
   run.options = read->options;
   run.t0_s = truth.front().t_s;
-  for (const eval::StampedPose& pose : truth) appendPose(run.truth, pose.t_s, pose.p_m, pose.q);
+  run.truth = truth;
   for (const auto& [name, estimates] : read->by_name) {
     if (name == truth_name) continue;
     run.sources[name] = sourceSeries(truth, estimates, read->options.truth_max_gap_s);
@@ -209,7 +204,7 @@ RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> 
   return run;
 }
 
-std::shared_ptr<RunTrajectories> trajectoriesOf(const eval::LogTrajectories& recorded,
+std::shared_ptr<RunTrajectories> trajectoriesOf(const logs::LogTrajectories& recorded,
                                                 const eval::EvalOptions& options) {
   auto read = std::make_shared<RunTrajectories>();
   read->by_name = recorded.sources;
@@ -227,6 +222,25 @@ void appendNumber(std::string& out, double value) {
 }
 
 }  // namespace
+
+FigureColumns figureColumns(const core::Trajectory& trajectory) {
+  FigureColumns columns;
+  for (const core::StampedPose& pose : trajectory) appendPose(columns, pose, kNaN);
+  return columns;
+}
+
+FigureColumns figureColumns(const SourceSeries& source) {
+  FigureColumns columns;
+  for (std::size_t i = 0; i < source.estimates.size(); ++i) {
+    const logs::SourceEstimate& e = source.estimates[i];
+    if (e.status == logs::SourceEstimate::kTracking) {
+      appendPose(columns, e, source.truth_yaw_rad[i]);
+    } else {
+      appendEmpty(columns, e.t_s);
+    }
+  }
+  return columns;
+}
 
 std::vector<std::string> trajectoryNames(const RunData& run) {
   return run.trajectories ? namesOf(*run.trajectories) : std::vector<std::string>{};
@@ -300,7 +314,7 @@ RunData loadRun(const std::string& path, const std::string& truth_name) {
     const fs::path log_path = is_log_file ? given : root / kLogName;
     const std::vector<fs::path> tum_files = is_log_file ? std::vector<fs::path>{} : tumFiles(root);
     if (isFile(log_path)) {
-      const eval::LogTrajectories recorded = eval::readRunLog(log_path.string());
+      const logs::LogTrajectories recorded = logs::readRunLog(log_path.string());
       read = trajectoriesOf(recorded, options);
       poses_from = log_path.string();
       damage = recorded.damage;
@@ -311,7 +325,7 @@ RunData loadRun(const std::string& path, const std::string& truth_name) {
       fs::path truth_file;
       for (const fs::path& file : tum_files) {
         names.push_back(file.stem().string());
-        read->by_name[names.back()] = trackingEstimates(readTumFile(file));
+        read->by_name[names.back()] = trackingEstimates(core::readTum(file.string()));
       }
       read->recorded_truth = isFile(root / kTruthName)
                                  ? std::string(kRecordedTruthName)
@@ -330,12 +344,16 @@ RunData loadRun(const std::string& path, const std::string& truth_name) {
     return buildRun(path, std::move(read), std::move(poses_from), std::move(damage), truth, true);
   } catch (const eval::EvalError& e) {
     throw RunDataError(e.what());
+  } catch (const core::TrajectoryError& e) {
+    throw RunDataError(e.what());
+  } catch (const logs::RunLogError& e) {
+    throw RunDataError(e.what());
   } catch (const fs::filesystem_error& e) {
     throw RunDataError(path + ": " + e.what());
   }
 }
 
-RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,
+RunData runFromPoses(const std::string& name, const logs::LogTrajectories& recorded,
                      const eval::EvalOptions& options) {
   if (recorded.truth.empty()) throw RunDataError(name + ": no truth pose");
   return buildRun(name, trajectoriesOf(recorded, options), {}, recorded.damage, kRecordedTruthName,
@@ -358,17 +376,17 @@ std::string resultsCsv(const eval::RunMetrics& metrics) {
 
 std::string figureDataCsv(const RunData& run, const std::string& figure,
                           const std::set<std::string>& hidden) {
-  using Field = const std::vector<double> PoseSeries::*;
+  using Field = const std::vector<double> FigureColumns::*;
   std::vector<Field> fields;
   std::string header;
   if (figure == "position") {
-    fields = {&PoseSeries::x_m, &PoseSeries::y_m, &PoseSeries::z_m};
+    fields = {&FigureColumns::x_m, &FigureColumns::y_m, &FigureColumns::z_m};
     header = "north_m,east_m,down_m";
   } else if (figure == "attitude") {
-    fields = {&PoseSeries::roll_deg, &PoseSeries::pitch_deg, &PoseSeries::yaw_deg};
+    fields = {&FigureColumns::roll_deg, &FigureColumns::pitch_deg, &FigureColumns::yaw_deg};
     header = "roll_deg,pitch_deg,yaw_deg";
   } else if (figure == "top_view") {
-    fields = {&PoseSeries::x_m, &PoseSeries::y_m};
+    fields = {&FigureColumns::x_m, &FigureColumns::y_m};
     header = "north_m,east_m";
   } else if (figure != "error") {
     throw RunDataError("no figure " + figure + " (position, attitude, error, top_view)");
@@ -376,7 +394,7 @@ std::string figureDataCsv(const RunData& run, const std::string& figure,
     header = "position_error_m";
   }
   std::string out = "trajectory,time_s," + header + "\n";
-  const auto rows = [&](const std::string& name, const PoseSeries& pose,
+  const auto rows = [&](const std::string& name, const FigureColumns& pose,
                         const std::vector<double>* error) {
     if (hidden.contains(name)) return;
     for (std::size_t i = 0; i < pose.size(); ++i) {
@@ -395,9 +413,9 @@ std::string figureDataCsv(const RunData& run, const std::string& figure,
       out += '\n';
     }
   };
-  if (figure != "error") rows(run.truth_name, run.truth, nullptr);
+  if (figure != "error") rows(run.truth_name, figureColumns(run.truth), nullptr);
   for (const auto& [name, source] : run.sources) {
-    rows(name, source.pose, figure == "error" ? &source.position_error_m : nullptr);
+    rows(name, figureColumns(source), figure == "error" ? &source.position_error_m : nullptr);
   }
   return out;
 }

@@ -19,7 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "core/trajectory.h"
 #include "logs/eval/run_metrics.h"
+#include "logs/run_log.h"
 
 namespace nadir::gui {
 
@@ -30,39 +32,40 @@ class RunDataError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// One pose series, sample by sample. Positions are world NED, m; angles Z-Y-X
-// (core/frames.h), deg. A sample without a pose (an estimate that is not TRACKING)
-// is NaN in every pose field.
-struct PoseSeries {
-  std::vector<double> t_s;
-  std::vector<double> x_m;  // north
-  std::vector<double> y_m;  // east
-  std::vector<double> z_m;  // down
-  std::vector<double> roll_deg;
-  std::vector<double> pitch_deg;
-  std::vector<double> yaw_deg;
+// One estimate source of a run, against the run's truth.
+struct SourceSeries {
+  // Every estimate in stamp order; its pose means something only when TRACKING.
+  std::vector<logs::SourceEstimate> estimates;
+  // |p_est - p_truth| at each estimate with the truth interpolated at its stamp, m;
+  // NaN where the estimate is not TRACKING or the truth has no pose there (outside
+  // its span, or over a hole longer than EvalOptions::truth_max_gap_s).
+  std::vector<double> position_error_m;
+  // The truth's yaw at each estimate, rad; NaN where position_error_m is.
+  std::vector<double> truth_yaw_rad;
+  // The TRACKING stretches (a stretch ends at any other status), as drawn in 3D.
+  std::vector<core::Trajectory> tracked;
+  std::size_t size() const { return estimates.size(); }
+};
+
+// A trajectory's samples as a figure plots them: stamps (absolute, s), north,
+// east, down (m) and Z-Y-X angles (core/frames.h, deg), NaN where a sample has
+// no pose. A source's yaw is taken on its truth's side of +-180 deg (so it may
+// lie outside [-180, 180]): a heading near south is drawn beside the truth's.
+struct FigureColumns {
+  std::vector<double> t_s, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg;
   std::size_t size() const { return t_s.size(); }
 };
+FigureColumns figureColumns(const core::Trajectory& trajectory);
+FigureColumns figureColumns(const SourceSeries& source);
 
-struct SourceSeries {
-  // Yaw is taken on the truth's side of +-180 deg where the truth has a pose (so it
-  // may lie outside [-180, 180]): a heading near south is drawn beside the truth's.
-  PoseSeries pose;
-  std::vector<int> status;  // eval::SourceEstimate::kInitializing, kTracking, kLost
-  // |p_est - p_truth| with the truth interpolated at the estimate's stamp, m; NaN
-  // where the estimate is not TRACKING or the truth has no pose there (outside its
-  // span, or over a hole longer than EvalOptions::truth_max_gap_s).
-  std::vector<double> position_error_m;
-};
-
-// The name of the truth as recorded: POSE_TRUTH in a log, truth.tum in a folder.
+// The name of the truth as recorded: the pose_t of a log, truth.tum in a folder.
 inline constexpr char kRecordedTruthName[] = "truth";
 
 // Every trajectory of a run as it was read, before one is chosen as the truth.
 struct RunTrajectories {
   // By name: the recorded truth and each estimate source, in stamp order, with
   // the estimates' statuses (a truth and a TUM file's poses are all TRACKING).
-  std::map<std::string, std::vector<eval::SourceEstimate>> by_name;
+  std::map<std::string, std::vector<logs::SourceEstimate>> by_name;
   // The one that is the truth unless another is chosen: kRecordedTruthName when
   // the run recorded one, else a guess (see recorded_truth_note).
   std::string recorded_truth;
@@ -81,7 +84,7 @@ struct RunData {
   std::string truth_note;                       // why truth_name is the truth, when it was guessed
   double t0_s = 0;            // the truth's first stamp: plots show time since then
   eval::EvalOptions options;  // metrics.json's options, or the defaults used to compute
-  PoseSeries truth;
+  core::Trajectory truth;
   std::map<std::string, SourceSeries> sources;  // every trajectory but the truth
   eval::RunMetrics metrics;
   // What was read, shared by the runs compareWithTruth makes of this one.
@@ -120,7 +123,7 @@ std::vector<std::string> findRuns(const std::string& root);
 // Loads one run: a run directory, or an LCM log file (its metrics.json is read
 // only if it is a run directory's run.lcmlog; else the metrics are computed).
 // RunData::dir is the path given. The truth is truth_name, or if that is empty the
-// recorded one: POSE_TRUTH in a log; in a folder of TUM files truth.tum, else the
+// recorded one: the pose_t in a log; in a folder of TUM files truth.tum, else the
 // file whose name says groundtruth, gt or truth, else the first by name (and
 // RunData::truth_note says it was guessed). Throws RunDataError naming the file
 // for a missing, damaged or foreign file (a file that is not an LCM log, a log
@@ -130,7 +133,7 @@ RunData loadRun(const std::string& path, const std::string& truth_name = {});
 
 // A run of poses already read (a live bus): the series of loadRun, named `name`
 // (RunData::dir), with the metrics left empty. Throws RunDataError without truth.
-RunData runFromPoses(const std::string& name, const eval::LogTrajectories& recorded,
+RunData runFromPoses(const std::string& name, const logs::LogTrajectories& recorded,
                      const eval::EvalOptions& options = {});
 
 // The error table, one row per source, as CSV with a header line:

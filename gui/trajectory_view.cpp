@@ -228,8 +228,8 @@ bool TrajectoryView::fitToRuns() {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const RunData& run : runs_) {
-    for (std::size_t i = 0; i < run.truth.size(); ++i) {
-      const Eigen::Vector3d p(run.truth.x_m[i], run.truth.y_m[i], run.truth.z_m[i]);
+    for (const core::StampedPose& pose : run.truth) {
+      const Eigen::Vector3d& p = pose.p_ned_m;
       if (!p.allFinite()) continue;
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
@@ -360,7 +360,7 @@ void TrajectoryView::paintGL() {
   for (const RunData& run : runs_) {
     for (const auto& [name, source] : run.sources) {
       const QColor color = sourceColor(run, name);
-      for (const auto& line : trackUpTo(source.pose, run.t0_s + time_s_)) {
+      for (const auto& line : trackUpTo(source, run.t0_s + time_s_)) {
         overlay.polyline(line, color, kSourceWidthPx);
       }
     }
@@ -368,7 +368,7 @@ void TrajectoryView::paintGL() {
   // Where each estimate is now, then the vehicle with its attitude.
   for (const RunData& run : runs_) {
     for (const auto& [name, source] : run.sources) {
-      if (const auto p = positionAt(source.pose, run.t0_s + time_s_)) {
+      if (const auto p = positionAt(source, run.t0_s + time_s_)) {
         overlay.square(*p, Qt::black, kEstimateHalfPx + 1.0);
         overlay.square(*p, sourceColor(run, name), kEstimateHalfPx);
       }

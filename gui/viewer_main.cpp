@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
       for (const nadir::gui::RunData& run : window.runs()) {
         std::printf("run %s: %zu truth poses", run.dir.c_str(), run.truth.size());
         for (const auto& [name, source] : run.sources) {
-          std::printf(", %s %zu estimates", name.c_str(), source.pose.size());
+          std::printf(", %s %zu estimates", name.c_str(), source.size());
         }
         std::printf("\n");
       }

@@ -4,91 +4,75 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/frames.h"
-
 namespace nadir::gui {
 namespace {
 
-bool hasPose(const PoseSeries& s, std::size_t i) {
-  return std::isfinite(s.x_m[i]) && std::isfinite(s.y_m[i]) && std::isfinite(s.z_m[i]);
-}
-
-Eigen::Vector3d at(const PoseSeries& s, std::size_t i) { return {s.x_m[i], s.y_m[i], s.z_m[i]}; }
-
-Eigen::Quaterniond attitudeOf(const PoseSeries& s, std::size_t i) {
-  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
-  return core::quaternionFromRpy(
-      {s.roll_deg[i] * kRadPerDeg, s.pitch_deg[i] * kRadPerDeg, s.yaw_deg[i] * kRadPerDeg});
-}
-
-// The samples around t_s and the fraction of the way from the first to the second
-// (the same sample twice at the series' last stamp), under positionAt's conditions.
-struct Bracket {
-  std::size_t i0 = 0;
-  std::size_t i1 = 0;
-  double a = 0.0;
-};
-
-std::optional<Bracket> bracket(const PoseSeries& series, double t_s, double max_gap_s) {
-  const auto& t = series.t_s;
-  if (t.empty() || t_s < t.front() || t_s > t.back()) return std::nullopt;
-  const auto upper = std::upper_bound(t.begin(), t.end(), t_s);
-  if (upper == t.end()) {
-    const std::size_t last = t.size() - 1;
-    if (!hasPose(series, last)) return std::nullopt;
-    return Bracket{last, last, 0.0};
+// The lines of one trajectory up to t_s, appended to lines.
+void appendTrackUpTo(const core::Trajectory& trajectory, double t_s, double max_gap_s,
+                     std::vector<std::vector<Eigen::Vector3d>>& lines) {
+  std::vector<Eigen::Vector3d> line;
+  double last_t = 0.0;
+  for (std::size_t i = 0; i < trajectory.size() && trajectory[i].t_s <= t_s; ++i) {
+    if (!line.empty() && trajectory[i].t_s - last_t > max_gap_s) {
+      lines.push_back(std::move(line));
+      line.clear();
+    }
+    line.push_back(trajectory[i].p_ned_m);
+    last_t = trajectory[i].t_s;
   }
-  const auto i1 = static_cast<std::size_t>(upper - t.begin());
-  const std::size_t i0 = i1 - 1;
-  if (!hasPose(series, i0) || !hasPose(series, i1) || t[i1] - t[i0] > max_gap_s) {
-    return std::nullopt;
+  if (const auto now = positionAt(trajectory, t_s, max_gap_s); now && !line.empty()) {
+    if ((*now - line.back()).norm() > 0.0) line.push_back(*now);
   }
-  return Bracket{i0, i1, (t_s - t[i0]) / (t[i1] - t[i0])};
+  if (!line.empty()) lines.push_back(std::move(line));
 }
 
 }  // namespace
 
-std::optional<Eigen::Vector3d> positionAt(const PoseSeries& series, double t_s, double max_gap_s) {
-  const std::optional<Bracket> b = bracket(series, t_s, max_gap_s);
-  if (!b) return std::nullopt;
-  return (1.0 - b->a) * at(series, b->i0) + b->a * at(series, b->i1);
+std::optional<Eigen::Vector3d> positionAt(const core::Trajectory& trajectory, double t_s,
+                                          double max_gap_s) {
+  const std::optional<core::StampedPose> pose = core::interpolate(trajectory, t_s, max_gap_s);
+  if (!pose) return std::nullopt;
+  return pose->p_ned_m;
 }
 
-std::optional<Eigen::Quaterniond> attitudeAt(const PoseSeries& series, double t_s,
+std::optional<Eigen::Vector3d> positionAt(const SourceSeries& source, double t_s,
+                                          double max_gap_s) {
+  for (const core::Trajectory& stretch : source.tracked) {
+    if (stretch.front().t_s <= t_s && t_s <= stretch.back().t_s) {
+      return positionAt(stretch, t_s, max_gap_s);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Eigen::Quaterniond> attitudeAt(const core::Trajectory& trajectory, double t_s,
                                              double max_gap_s) {
-  const std::optional<Bracket> b = bracket(series, t_s, max_gap_s);
-  if (!b) return std::nullopt;
-  return attitudeOf(series, b->i0).slerp(b->a, attitudeOf(series, b->i1));
+  const std::optional<core::StampedPose> pose = core::interpolate(trajectory, t_s, max_gap_s);
+  if (!pose) return std::nullopt;
+  return pose->q_world_body;
 }
 
-std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const PoseSeries& series, double t_s,
+std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const core::Trajectory& trajectory, double t_s,
                                                     double max_gap_s) {
   std::vector<std::vector<Eigen::Vector3d>> lines;
-  std::vector<Eigen::Vector3d> line;
-  double last_t = 0.0;
-  for (std::size_t i = 0; i < series.size() && series.t_s[i] <= t_s; ++i) {
-    const bool broken =
-        !hasPose(series, i) || (!line.empty() && series.t_s[i] - last_t > max_gap_s);
-    if (broken) {
-      if (!line.empty()) lines.push_back(std::move(line));
-      line.clear();
-    }
-    if (hasPose(series, i)) {
-      line.push_back(at(series, i));
-      last_t = series.t_s[i];
-    }
+  appendTrackUpTo(trajectory, t_s, max_gap_s, lines);
+  return lines;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const SourceSeries& source, double t_s,
+                                                    double max_gap_s) {
+  std::vector<std::vector<Eigen::Vector3d>> lines;
+  for (const core::Trajectory& stretch : source.tracked) {
+    if (stretch.front().t_s > t_s) break;
+    appendTrackUpTo(stretch, t_s, max_gap_s, lines);
   }
-  if (const auto now = positionAt(series, t_s, max_gap_s); now && !line.empty()) {
-    if ((*now - line.back()).norm() > 0.0) line.push_back(*now);
-  }
-  if (!line.empty()) lines.push_back(std::move(line));
   return lines;
 }
 
 double playbackDuration(const std::vector<RunData>& runs) {
   double duration = 0.0;
   for (const RunData& run : runs) {
-    if (!run.truth.t_s.empty()) duration = std::max(duration, run.truth.t_s.back() - run.t0_s);
+    if (!run.truth.empty()) duration = std::max(duration, run.truth.back().t_s - run.t0_s);
   }
   return duration;
 }

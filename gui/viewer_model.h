@@ -18,21 +18,24 @@ namespace nadir::gui {
 // A line breaks where samples are further apart than this, as in nadir-plot.
 inline constexpr double kViewerMaxGap_s = 1.0;
 
-// The series' position at t_s (absolute stamp) interpolated linearly between the
-// samples around it; nothing outside its span, next to a sample without a pose or
-// across a gap longer than max_gap_s.
-std::optional<Eigen::Vector3d> positionAt(const PoseSeries& series, double t_s,
+// A trajectory's position and attitude (body to world NED) at t_s (absolute
+// stamp), interpolated by core::interpolate; nothing outside its span or across
+// a gap longer than max_gap_s. A source's are those of its TRACKING stretch
+// holding t_s.
+std::optional<Eigen::Vector3d> positionAt(const core::Trajectory& trajectory, double t_s,
                                           double max_gap_s = kViewerMaxGap_s);
-
-// The series' attitude (body to world NED) at t_s, interpolated (slerp) between the
-// samples around it, under positionAt's conditions.
-std::optional<Eigen::Quaterniond> attitudeAt(const PoseSeries& series, double t_s,
+std::optional<Eigen::Vector3d> positionAt(const SourceSeries& source, double t_s,
+                                          double max_gap_s = kViewerMaxGap_s);
+std::optional<Eigen::Quaterniond> attitudeAt(const core::Trajectory& trajectory, double t_s,
                                              double max_gap_s = kViewerMaxGap_s);
 
-// The series' polylines from its start up to t_s (absolute stamp), broken where a
-// sample has no pose or samples are more than max_gap_s apart. The last polyline
-// ends at positionAt(t_s) when that exists, so a line grows smoothly with time.
-std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const PoseSeries& series, double t_s,
+// The polylines from the start up to t_s (absolute stamp), broken where samples
+// are more than max_gap_s apart (and, for a source, between TRACKING stretches).
+// The last polyline ends at positionAt(t_s) when that exists, so a line grows
+// smoothly with time.
+std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const core::Trajectory& trajectory, double t_s,
+                                                    double max_gap_s = kViewerMaxGap_s);
+std::vector<std::vector<Eigen::Vector3d>> trackUpTo(const SourceSeries& source, double t_s,
                                                     double max_gap_s = kViewerMaxGap_s);
 
 // Playback span: 0 to the longest truth's duration, s.

@@ -368,8 +368,7 @@ void ViewerWindow::runsChanged() {
                         ? QStringLiteral("(over another world than the terrain shown)")
                         : QString());
   }
-  legend_->setText(runs_.empty() ? QStringLiteral("waiting for the truth on %1")
-                                       .arg(QString::fromUtf8(eval::kTruthChannel))
+  legend_->setText(runs_.empty() ? QStringLiteral("waiting for the truth (pose_t)")
                                  : viewerLegend(runs_, notes));
   // View > Terrain: the scenario of any run that has one, or none; rebuilt only
   // when that changes (live mode comes here several times a second).

@@ -16,11 +16,11 @@
 
 #include "core/bus.h"
 #include "core/clock.h"
-#include "nadir/vo_estimate_t.hpp"
+#include "lcmtypes/codec.h"
+#include "nodes/scenario.h"
 #include "nodes/sim/simulator.h"
 #include "run/process.h"
 #include "run/run.h"
-#include "nodes/scenario.h"
 #include "terrain/world_factory.h"
 
 namespace nadir::run {
@@ -132,7 +132,6 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   channels[scenario.sim.truth.channel].expected_hz = scenario.sim.truth.rate_hz;
   for (const auto& [name, spec] : scenario.allCameras())
     channels[spec.channel].expected_hz = spec.fps;
-  const std::vector<std::string> vo_channels = {"POSE_PPA", "POSE_VO_FEATURE", "POSE_VO_DIRECT"};
   auto subscription = bus->subscribe(".*", [&](const core::RawMessage& raw) {
     ChannelHealth& health = channels[std::string(raw.channel)];
     ++health.total;
@@ -141,10 +140,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       if (!health.first_utime) health.first_utime = *utime;
       health.last_utime = std::max(*utime, health.last_utime.value_or(*utime));
     }
-    if (std::find(vo_channels.begin(), vo_channels.end(), raw.channel) != vo_channels.end()) {
-      nadir::vo_estimate_t estimate;
-      if (estimate.decode(raw.data, 0, static_cast<int>(raw.size)) > 0) {
-        health.vo_status = estimate.status;
+    if (msg::isType<msg::VoEstimate>(raw.data, raw.size)) {
+      try {
+        health.vo_status =
+            static_cast<int>(msg::decode<msg::VoEstimate>(raw.data, raw.size).status);
+      } catch (const std::exception&) {
       }
     }
   });

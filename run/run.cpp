@@ -13,18 +13,16 @@
 #include "core/bus.h"
 #include "core/clock.h"
 #include "core/lcm_log.h"
-#include "logs/eval/trajectory.h"
-#include "nadir/target_detection_t.hpp"
-#include "nodes/camera/camera_messages.h"
+#include "lcmtypes/bus_io.h"
 #include "nodes/camera/camera_node.h"
 #include "nodes/ppa/ppa_node.h"
+#include "nodes/scenario.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
 #include "nodes/vo_feature/vo_feature_node.h"
 #include "run/process.h"
 #include "run/target_passes.h"
 #include "run/track_plot.h"
-#include "nodes/scenario.h"
 #include "terrain/world.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -85,10 +83,10 @@ RunResult runScenario(const RunOptions& options,
 
   camera::CameraNode camera(*bus, scenario::cameraNodeParams(scenario));
   // The main camera's last image, for a picture of what it saw.
-  nadir::image_t last_image;
-  core::Subscription last_image_keeper = core::subscribe<nadir::image_t>(
+  cv::Mat last_image;
+  core::Subscription last_image_keeper = msg::subscribe<msg::Image>(
       *bus, scenario.camera.channel,
-      [&last_image](const nadir::image_t& image) { last_image = image; });
+      [&last_image](const msg::Image& image) { last_image = image.pixels; });
   const core::LocalNedFrame frame(camera.scene().built.origin);
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
@@ -104,8 +102,8 @@ RunResult runScenario(const RunOptions& options,
   }
   if (scenario.ppa.enabled) {
     ppa_node.emplace(*bus, scenario.ppa, targets_ne_m);
-    detector_subscription.push_back(core::subscribe<nadir::target_detection_t>(
-        *bus, scenario.ppa.target_channel, [&detector_frames](const nadir::target_detection_t& d) {
+    detector_subscription.push_back(msg::subscribe<msg::TargetDetection>(
+        *bus, scenario.ppa.target_channel, [&detector_frames](const msg::TargetDetection& d) {
           detector_frames.emplace_back(core::secondsFromUtime(d.utime), d.detected);
         }));
   }
@@ -136,27 +134,27 @@ RunResult runScenario(const RunOptions& options,
   report(true);
   log.flush();
 
-  const eval::RunEvaluation evaluation =
-      eval::evaluateRunLog(result.log_path, out.string(), eval::EvalOptions{});
-  const eval::LogTrajectories& recorded = evaluation.recorded;
+  const eval::RunEvaluation evaluation = eval::evaluateRunLog(
+      result.log_path, out.string(), eval::EvalOptions{}, scenario.sim.truth.channel);
+  const logs::LogTrajectories& recorded = evaluation.recorded;
   result.metrics = evaluation.metrics;
   result.metrics_path = evaluation.metrics_path;
   result.tum_paths = evaluation.tum_paths;
   result.picture_paths.push_back((out / "tracks.png").string());
   writeTrackPlot(result.picture_paths.back(), recorded.truth, evaluation.tracked,
                  fs::path(options.scenario).stem().string() + ": top view");
-  if (!last_image.data.empty()) {
+  if (!last_image.empty()) {
     result.picture_paths.push_back((out / "last_frame.png").string());
-    cv::imwrite(result.picture_paths.back(), camera::imageFromMessage(last_image));
+    cv::imwrite(result.picture_paths.back(), last_image);
   }
   result.table = eval::formatResultsTable(result.metrics);
   if (scenario.ppa.enabled && scenario.ppa.target_extraction && !targets_ne_m.empty() &&
       recorded.sources.count("ppa") != 0) {
     TargetPassInput passes;
     passes.truth = recorded.truth;
-    for (const eval::StampedPose& pose : recorded.truth) {
+    for (const core::StampedPose& pose : recorded.truth) {
       passes.truth_height_m.push_back(terrain::heightAboveGround_m(
-          *camera.scene().built.world, pose.p_m.x(), pose.p_m.y(), pose.p_m.z()));
+          *camera.scene().built.world, pose.p_ned_m.x(), pose.p_ned_m.y(), pose.p_ned_m.z()));
     }
     passes.estimates = recorded.sources.at("ppa");
     passes.detector_frames = detector_frames;

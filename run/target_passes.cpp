@@ -9,30 +9,30 @@ namespace {
 
 // Horizontal error of the TRACKING estimate nearest t_s (within 0.1 s).
 std::optional<double> errorAt(const TargetPassInput& input, double t_s) {
-  const eval::SourceEstimate* best = nullptr;
-  for (const eval::SourceEstimate& estimate : input.estimates) {
-    if (estimate.status != eval::SourceEstimate::kTracking) continue;
+  const logs::SourceEstimate* best = nullptr;
+  for (const logs::SourceEstimate& estimate : input.estimates) {
+    if (estimate.status != logs::SourceEstimate::kTracking) continue;
     if (best == nullptr || std::abs(estimate.t_s - t_s) < std::abs(best->t_s - t_s)) {
       best = &estimate;
     }
   }
   if (best == nullptr || std::abs(best->t_s - t_s) > 0.1) return std::nullopt;
-  const auto truth = eval::interpolate(input.truth, best->t_s);
+  const auto truth = core::interpolate(input.truth, best->t_s);
   if (!truth) return std::nullopt;
-  return (best->p_m - truth->p_m).head<2>().norm();
+  return (best->p_ned_m - truth->p_ned_m).head<2>().norm();
 }
 
 // Horizontal error of the last TRACKING estimate before t_s (the state before a
 // correction at t_s), if it is within 0.1 s.
 std::optional<double> errorBefore(const TargetPassInput& input, double t_s) {
-  const eval::SourceEstimate* best = nullptr;
-  for (const eval::SourceEstimate& estimate : input.estimates) {
-    if (estimate.status == eval::SourceEstimate::kTracking && estimate.t_s < t_s) best = &estimate;
+  const logs::SourceEstimate* best = nullptr;
+  for (const logs::SourceEstimate& estimate : input.estimates) {
+    if (estimate.status == logs::SourceEstimate::kTracking && estimate.t_s < t_s) best = &estimate;
   }
   if (best == nullptr || t_s - best->t_s > 0.1) return std::nullopt;
-  const auto truth = eval::interpolate(input.truth, best->t_s);
+  const auto truth = core::interpolate(input.truth, best->t_s);
   if (!truth) return std::nullopt;
-  return (best->p_m - truth->p_m).head<2>().norm();
+  return (best->p_ned_m - truth->p_ned_m).head<2>().norm();
 }
 
 }  // namespace
@@ -44,7 +44,8 @@ std::vector<TargetPass> targetPasses(const TargetPassInput& input) {
     std::optional<TargetPass> open;
     for (std::size_t i = 0; i < input.truth.size(); ++i) {
       const double reach_m = input.view_fraction * input.truth_height_m[i] * tan_half;
-      const bool in_view = (input.truth[i].p_m.head<2>() - input.targets_ne_m[k]).norm() < reach_m;
+      const bool in_view =
+          (input.truth[i].p_ned_m.head<2>() - input.targets_ne_m[k]).norm() < reach_m;
       const double t = input.truth[i].t_s;
       if (in_view && !open) open = TargetPass{static_cast<int>(k), t, t, 0, 0, {}, {}};
       if (in_view) open->end_s = t;

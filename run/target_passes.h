@@ -11,7 +11,8 @@
 
 #include <Eigen/Core>
 
-#include "logs/eval/run_metrics.h"
+#include "core/trajectory.h"
+#include "logs/run_log.h"
 
 namespace nadir::run {
 
@@ -26,10 +27,10 @@ struct TargetPass {
 };
 
 struct TargetPassInput {
-  eval::PoseTrajectory truth;
+  core::Trajectory truth;
   // Height of the body above the ground at each truth pose, m.
   std::vector<double> truth_height_m;
-  std::vector<eval::SourceEstimate> estimates;
+  std::vector<logs::SourceEstimate> estimates;
   // Time of every detector frame, and whether it found a target.
   std::vector<std::pair<double, bool>> detector_frames;
   std::vector<Eigen::Vector2d> targets_ne_m;

@@ -26,18 +26,18 @@ double niceLength(double limit) {
 
 }  // namespace
 
-void writeTrackPlot(const std::string& png_path, const eval::PoseTrajectory& truth,
-                    const std::map<std::string, eval::PoseTrajectory>& sources,
+void writeTrackPlot(const std::string& png_path, const core::Trajectory& truth,
+                    const std::map<std::string, core::Trajectory>& sources,
                     const std::string& title) {
   constexpr int kSize = 900, kMargin = 60;
   cv::Mat image(kSize, kSize, CV_8UC3, cv::Scalar(255, 255, 255));
   double min_n = 1e300, max_n = -1e300, min_e = 1e300, max_e = -1e300;
-  const auto extend = [&](const eval::PoseTrajectory& track) {
-    for (const eval::StampedPose& pose : track) {
-      min_n = std::min(min_n, pose.p_m.x());
-      max_n = std::max(max_n, pose.p_m.x());
-      min_e = std::min(min_e, pose.p_m.y());
-      max_e = std::max(max_e, pose.p_m.y());
+  const auto extend = [&](const core::Trajectory& track) {
+    for (const core::StampedPose& pose : track) {
+      min_n = std::min(min_n, pose.p_ned_m.x());
+      max_n = std::max(max_n, pose.p_ned_m.x());
+      min_e = std::min(min_e, pose.p_ned_m.y());
+      max_e = std::max(max_e, pose.p_ned_m.y());
     }
   };
   extend(truth);
@@ -53,9 +53,9 @@ void writeTrackPlot(const std::string& png_path, const eval::PoseTrajectory& tru
     return cv::Point(static_cast<int>(std::lround(kSize / 2 + (p.y() - centre_e) * scale)),
                      static_cast<int>(std::lround(kSize / 2 - (p.x() - centre_n) * scale)));
   };
-  const auto draw = [&](const eval::PoseTrajectory& track, const cv::Scalar& colour, int width) {
+  const auto draw = [&](const core::Trajectory& track, const cv::Scalar& colour, int width) {
     std::vector<cv::Point> points;
-    for (const eval::StampedPose& pose : track) points.push_back(pixel(pose.p_m));
+    for (const core::StampedPose& pose : track) points.push_back(pixel(pose.p_ned_m));
     if (points.size() >= 2) cv::polylines(image, points, false, colour, width, cv::LINE_AA);
     if (!points.empty()) cv::circle(image, points.front(), 5, colour, cv::FILLED, cv::LINE_AA);
   };

@@ -10,8 +10,8 @@
 namespace nadir::run {
 
 // Throws std::runtime_error naming the path if it cannot be written.
-void writeTrackPlot(const std::string& png_path, const eval::PoseTrajectory& truth,
-                    const std::map<std::string, eval::PoseTrajectory>& sources,
+void writeTrackPlot(const std::string& png_path, const core::Trajectory& truth,
+                    const std::map<std::string, core::Trajectory>& sources,
                     const std::string& title);
 
 }  // namespace nadir::run

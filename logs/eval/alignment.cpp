@@ -74,22 +74,23 @@ Alignment umeyamaAlignment(const std::vector<Eigen::Vector3d>& est,
   return alignment;
 }
 
-Alignment alignTrajectories(const PoseTrajectory& ref, const PoseTrajectory& est, AlignMode mode) {
+Alignment alignTrajectories(const core::Trajectory& ref, const core::Trajectory& est,
+                            AlignMode mode) {
   if (mode == AlignMode::kNone) return {};
   std::vector<Eigen::Vector3d> ref_p;
   std::vector<Eigen::Vector3d> est_p;
   ref_p.reserve(ref.size());
   est_p.reserve(est.size());
-  for (const StampedPose& pose : ref) ref_p.push_back(pose.p_m);
-  for (const StampedPose& pose : est) est_p.push_back(pose.p_m);
+  for (const core::StampedPose& pose : ref) ref_p.push_back(pose.p_ned_m);
+  for (const core::StampedPose& pose : est) est_p.push_back(pose.p_ned_m);
   return umeyamaAlignment(est_p, ref_p, mode == AlignMode::kSim3);
 }
 
-void applyAlignment(const Alignment& alignment, PoseTrajectory& trajectory) {
+void applyAlignment(const Alignment& alignment, core::Trajectory& trajectory) {
   const Eigen::Quaterniond q_align(alignment.R);
-  for (StampedPose& pose : trajectory) {
-    pose.p_m = alignment.scale * (alignment.R * pose.p_m) + alignment.t;
-    pose.q = (q_align * pose.q).normalized();
+  for (core::StampedPose& pose : trajectory) {
+    pose.p_ned_m = alignment.scale * (alignment.R * pose.p_ned_m) + alignment.t;
+    pose.q_world_body = (q_align * pose.q_world_body).normalized();
   }
 }
 

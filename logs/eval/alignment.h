@@ -32,10 +32,11 @@ Alignment umeyamaAlignment(const std::vector<Eigen::Vector3d>& est,
                            const std::vector<Eigen::Vector3d>& ref, bool with_scale);
 
 // The alignment of est onto ref (associated pose by pose) for a mode.
-Alignment alignTrajectories(const PoseTrajectory& ref, const PoseTrajectory& est, AlignMode mode);
+Alignment alignTrajectories(const core::Trajectory& ref, const core::Trajectory& est,
+                            AlignMode mode);
 
 // Moves every pose of trajectory: p <- scale R p + t, R_world_body <- R R_world_body
 // (the scale acts on positions only, as evo's PosePath3D.align).
-void applyAlignment(const Alignment& alignment, PoseTrajectory& trajectory);
+void applyAlignment(const Alignment& alignment, core::Trajectory& trajectory);
 
 }  // namespace nadir::eval

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
-void requireSameSize(const PoseTrajectory& ref, const PoseTrajectory& est, const char* what) {
+void requireSameSize(const core::Trajectory& ref, const core::Trajectory& est, const char* what) {
   if (ref.size() != est.size()) {
     throw EvalError(std::string(what) + ": " + std::to_string(ref.size()) + " reference and " +
                     std::to_string(est.size()) +
@@ -21,10 +21,10 @@ void requireSameSize(const PoseTrajectory& ref, const PoseTrajectory& est, const
   }
 }
 
-Eigen::Isometry3d isometry(const StampedPose& pose) {
+Eigen::Isometry3d isometry(const core::StampedPose& pose) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = pose.q.toRotationMatrix();
-  T.translation() = pose.p_m;
+  T.linear() = pose.q_world_body.toRotationMatrix();
+  T.translation() = pose.p_ned_m;
   return T;
 }
 
@@ -113,20 +113,21 @@ double rotationAngleDeg(const Eigen::Quaterniond& q) {
   return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())) * kRadToDeg;
 }
 
-std::vector<double> apeTranslationErrors(const PoseTrajectory& ref, const PoseTrajectory& est) {
+std::vector<double> apeTranslationErrors(const core::Trajectory& ref, const core::Trajectory& est) {
   requireSameSize(ref, est, "APE");
   std::vector<double> errors;
   errors.reserve(ref.size());
-  for (std::size_t i = 0; i < ref.size(); ++i) errors.push_back((est[i].p_m - ref[i].p_m).norm());
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    errors.push_back((est[i].p_ned_m - ref[i].p_ned_m).norm());
   return errors;
 }
 
-std::vector<double> apeRotationErrorsDeg(const PoseTrajectory& ref, const PoseTrajectory& est) {
+std::vector<double> apeRotationErrorsDeg(const core::Trajectory& ref, const core::Trajectory& est) {
   requireSameSize(ref, est, "APE");
   std::vector<double> errors;
   errors.reserve(ref.size());
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    errors.push_back(rotationAngleDeg(est[i].q.conjugate() * ref[i].q));
+    errors.push_back(rotationAngleDeg(est[i].q_world_body.conjugate() * ref[i].q_world_body));
   }
   return errors;
 }
@@ -137,7 +138,7 @@ DeltaUnit parseDeltaUnit(const std::string& name) {
   throw EvalError("unknown RPE delta unit '" + name + "' (expected frames or meters)");
 }
 
-IndexPairs rpePairs(const PoseTrajectory& poses, double delta, DeltaUnit unit) {
+IndexPairs rpePairs(const core::Trajectory& poses, double delta, DeltaUnit unit) {
   IndexPairs pairs;
   std::vector<std::size_t> ids;
   if (unit == DeltaUnit::kFrames) {
@@ -147,7 +148,7 @@ IndexPairs rpePairs(const PoseTrajectory& poses, double delta, DeltaUnit unit) {
   } else {
     double path = 0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
-      if (i > 0) path += (poses[i].p_m - poses[i - 1].p_m).norm();
+      if (i > 0) path += (poses[i].p_ned_m - poses[i - 1].p_ned_m).norm();
       if (path >= delta) {
         ids.push_back(i);
         path = 0;
@@ -158,7 +159,7 @@ IndexPairs rpePairs(const PoseTrajectory& poses, double delta, DeltaUnit unit) {
   return pairs;
 }
 
-RelativeErrors rpeErrors(const PoseTrajectory& ref, const PoseTrajectory& est,
+RelativeErrors rpeErrors(const core::Trajectory& ref, const core::Trajectory& est,
                          const IndexPairs& pairs) {
   requireSameSize(ref, est, "RPE");
   RelativeErrors errors;
@@ -174,21 +175,22 @@ RelativeErrors rpeErrors(const PoseTrajectory& ref, const PoseTrajectory& est,
   return errors;
 }
 
-double thesisPositionRmse(const PoseTrajectory& ref, const PoseTrajectory& est) {
+double thesisPositionRmse(const core::Trajectory& ref, const core::Trajectory& est) {
   requireSameSize(ref, est, "position RMSE");
   if (ref.empty()) return kNaN;
   double sum = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) sum += (est[i].p_m - ref[i].p_m).squaredNorm();
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    sum += (est[i].p_ned_m - ref[i].p_ned_m).squaredNorm();
   return std::sqrt(sum / static_cast<double>(ref.size()));
 }
 
-double thesisRotationRmseDeg(const PoseTrajectory& ref, const PoseTrajectory& est) {
+double thesisRotationRmseDeg(const core::Trajectory& ref, const core::Trajectory& est) {
   requireSameSize(ref, est, "rotation RMSE");
   if (ref.empty()) return kNaN;
   double sum = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    const core::RollPitchYaw truth = core::rpyFromQuaternion(ref[i].q);
-    const core::RollPitchYaw estimate = core::rpyFromQuaternion(est[i].q);
+    const core::RollPitchYaw truth = core::rpyFromQuaternion(ref[i].q_world_body);
+    const core::RollPitchYaw estimate = core::rpyFromQuaternion(est[i].q_world_body);
     const double d_roll = wrapPi(estimate.roll_rad - truth.roll_rad) * kRadToDeg;
     const double d_pitch = wrapPi(estimate.pitch_rad - truth.pitch_rad) * kRadToDeg;
     const double d_yaw = wrapPi(estimate.yaw_rad - truth.yaw_rad) * kRadToDeg;
@@ -197,13 +199,13 @@ double thesisRotationRmseDeg(const PoseTrajectory& ref, const PoseTrajectory& es
   return std::sqrt(sum / static_cast<double>(ref.size()));
 }
 
-double meanAbsoluteError(const PoseTrajectory& ref, const PoseTrajectory& est) {
+double meanAbsoluteError(const core::Trajectory& ref, const core::Trajectory& est) {
   const std::vector<double> errors = apeTranslationErrors(ref, est);
   if (errors.empty()) return kNaN;
   return std::accumulate(errors.begin(), errors.end(), 0.0) / static_cast<double>(errors.size());
 }
 
-TrajectoryEvaluation evaluateTrajectories(const PoseTrajectory& ref, const PoseTrajectory& est,
+TrajectoryEvaluation evaluateTrajectories(const core::Trajectory& ref, const core::Trajectory& est,
                                           const EvalOptions& options) {
   validateOptions(options);
   TrajectoryEvaluation result;
@@ -216,8 +218,8 @@ TrajectoryEvaluation evaluateTrajectories(const PoseTrajectory& ref, const PoseT
                     std::to_string(est.size()) + " estimated poses are within t_max_diff " +
                     formatShort(options.t_max_diff_s) + " s of a reference pose (need 2)");
   }
-  PoseTrajectory ref_matched;
-  PoseTrajectory est_matched;
+  core::Trajectory ref_matched;
+  core::Trajectory est_matched;
   for (const auto& [i_ref, i_est] : pairs) {
     ref_matched.push_back(ref[i_ref]);
     est_matched.push_back(est[i_est]);

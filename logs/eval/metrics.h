@@ -61,10 +61,10 @@ void validateOptions(const EvalOptions& options);
 double rotationAngleDeg(const Eigen::Quaterniond& q);
 
 // APE translation part (evo PoseRelation.translation_part): |p_est,i - p_ref,i|, m.
-std::vector<double> apeTranslationErrors(const PoseTrajectory& ref, const PoseTrajectory& est);
+std::vector<double> apeTranslationErrors(const core::Trajectory& ref, const core::Trajectory& est);
 // APE rotation angle (evo PoseRelation.rotation_angle_deg): the angle of the
 // rotation of E_i = P_est,i^-1 P_ref,i (evo's ape_base), degrees.
-std::vector<double> apeRotationErrorsDeg(const PoseTrajectory& ref, const PoseTrajectory& est);
+std::vector<double> apeRotationErrorsDeg(const core::Trajectory& ref, const core::Trajectory& est);
 
 enum class DeltaUnit { kFrames, kMeters };
 DeltaUnit parseDeltaUnit(const std::string& name);  // "frames" | "meters"; else EvalError
@@ -77,7 +77,7 @@ using IndexPairs = std::vector<std::pair<std::size_t, std::size_t>>;
 //    pairs are consecutive chosen ids. As in evo, the first chosen id is the
 //    first pose at path distance >= delta from pose 0 (pose 0 itself is not one).
 // Pairs are chosen on the estimate (evo's default, pairs_from_reference off).
-IndexPairs rpePairs(const PoseTrajectory& poses, double delta, DeltaUnit unit);
+IndexPairs rpePairs(const core::Trajectory& poses, double delta, DeltaUnit unit);
 
 // RPE for pairs (i, j) (evo's rpe_base):
 //   E = (P_ref,i^-1 P_ref,j)^-1 (P_est,i^-1 P_est,j)
@@ -86,21 +86,21 @@ struct RelativeErrors {
   std::vector<double> translation_m;
   std::vector<double> rotation_deg;
 };
-RelativeErrors rpeErrors(const PoseTrajectory& ref, const PoseTrajectory& est,
+RelativeErrors rpeErrors(const core::Trajectory& ref, const core::Trajectory& est,
                          const IndexPairs& pairs);
 
 // Thesis (seed 002) eq. 13: sqrt( sum_i [(x'_i-x_i)^2 + (y'_i-y_i)^2 + (z'_i-z_i)^2] / n ),
 // the sum of the three squared axis errors over n poses: the RMSE of the norm
 // of the position error vector (not the per-axis RMSE, which is sqrt(3) smaller). m.
-double thesisPositionRmse(const PoseTrajectory& ref, const PoseTrajectory& est);
+double thesisPositionRmse(const core::Trajectory& ref, const core::Trajectory& est);
 // Thesis eq. 14: the same over the Z-Y-X Euler angle differences (roll, pitch,
 // yaw from core::rpyFromQuaternion), each wrapped to (-180, 180] deg. Like any
 // Euler difference it is ill-conditioned near pitch +-90 deg; APE rotation is the
 // frame-independent alternative. Degrees.
-double thesisRotationRmseDeg(const PoseTrajectory& ref, const PoseTrajectory& est);
+double thesisRotationRmseDeg(const core::Trajectory& ref, const core::Trajectory& est);
 
 // Seed 000's mean absolute error: mean over poses of |p_est,i - p_ref,i|, m.
-double meanAbsoluteError(const PoseTrajectory& ref, const PoseTrajectory& est);
+double meanAbsoluteError(const core::Trajectory& ref, const core::Trajectory& est);
 
 // The `--ref/--est` evaluation: associate (t_max_diff_s), align, APE and RPE.
 struct TrajectoryEvaluation {
@@ -116,7 +116,7 @@ struct TrajectoryEvaluation {
 };
 // Throws EvalError if fewer than 2 poses associate (saying how many and the
 // t_max_diff used), if the alignment is degenerate, or if the RPE delta gives no pair.
-TrajectoryEvaluation evaluateTrajectories(const PoseTrajectory& ref, const PoseTrajectory& est,
+TrajectoryEvaluation evaluateTrajectories(const core::Trajectory& ref, const core::Trajectory& est,
                                           const EvalOptions& options);
 
 // evo-like text: each metric's statistics, then the APE translation RMSE in

@@ -10,21 +10,14 @@
 #include <limits>
 #include <optional>
 
-#include "core/bus.h"
 #include "core/frames.h"
-#include "core/lcm_log.h"
-#include "nadir/pose_t.hpp"
-#include "nadir/vo_estimate_t.hpp"
 
 namespace nadir::eval {
 namespace {
 
-using Json = nlohmann::ordered_json;
+using logs::appendNote;
 
-void appendNote(std::string& notes, const std::string& note) {
-  if (!notes.empty()) notes += "; ";
-  notes += note;
-}
+using Json = nlohmann::ordered_json;
 
 double median(std::vector<double> values) {
   if (values.empty()) return kNaN;
@@ -197,7 +190,7 @@ std::string cell(double value, int decimals) {
 
 }  // namespace
 
-SourceMetrics evaluateSource(const PoseTrajectory& truth,
+SourceMetrics evaluateSource(const core::Trajectory& truth,
                              const std::vector<SourceEstimate>& estimates,
                              const EvalOptions& options) {
   validateOptions(options);
@@ -222,8 +215,8 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
   m.tracked_pct = 100.0 * trackedTime(sorted, t0, t1, options.tracked_hold_periods) / (t1 - t0);
 
   // Evaluated pairs, with the tracking segment each belongs to.
-  PoseTrajectory ref;
-  PoseTrajectory est;
+  core::Trajectory ref;
+  core::Trajectory est;
   std::vector<std::size_t> segment_of;
   bool in_segment = false;
   std::size_t outside_truth = 0;
@@ -235,14 +228,14 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
     if (!in_segment) ++m.tracking_segments;
     in_segment = true;
     if (m.estimates_tracking++ == 0) m.first_tracking_s = e.t_s - t0;
-    const std::optional<StampedPose> truth_here =
-        interpolate(truth, e.t_s, options.truth_max_gap_s);
+    const std::optional<core::StampedPose> truth_here =
+        core::interpolate(truth, e.t_s, options.truth_max_gap_s);
     if (!truth_here) {
       ++outside_truth;
       continue;
     }
     ref.push_back(*truth_here);
-    est.push_back(StampedPose{e.t_s, e.p_m, e.q.normalized()});
+    est.push_back(core::StampedPose{e.t_s, e.p_ned_m, e.q_world_body.normalized()});
     segment_of.push_back(m.tracking_segments);
   }
   m.initialised = m.estimates_tracking > 0;
@@ -261,7 +254,7 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
   m.position_rmse_m = thesisPositionRmse(ref, est);
   m.rotation_rmse_deg = thesisRotationRmseDeg(ref, est);
   m.mean_abs_error_m = meanAbsoluteError(ref, est);
-  m.end_point_m = (est.back().p_m - ref.back().p_m).norm();
+  m.end_point_m = (est.back().p_ned_m - ref.back().p_ned_m).norm();
 
   // Segment boundaries [begin, end) in the evaluated pairs.
   std::vector<std::pair<std::size_t, std::size_t>> segments;
@@ -275,8 +268,8 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
     std::size_t last = begin;
     for (std::size_t i = begin + 1; i < end; ++i) {
       if (i + 1 != end && ref[i].t_s - ref[last].t_s < options.track_length_interval_s) continue;
-      m.track_length_m += (est[i].p_m - est[last].p_m).norm();
-      m.truth_track_length_m += (ref[i].p_m - ref[last].p_m).norm();
+      m.track_length_m += (est[i].p_ned_m - est[last].p_ned_m).norm();
+      m.truth_track_length_m += (ref[i].p_ned_m - ref[last].p_ned_m).norm();
       last = i;
     }
   }
@@ -293,7 +286,7 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
     return m;
   }
   m.alignment_scale = alignment.scale;
-  PoseTrajectory aligned = est;
+  core::Trajectory aligned = est;
   applyAlignment(alignment, aligned);
   m.ape_translation_m = computeStatistics(apeTranslationErrors(ref, aligned));
   m.ape_rotation_deg = computeStatistics(apeRotationErrorsDeg(ref, aligned));
@@ -301,8 +294,8 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
   IndexPairs pairs;
   const DeltaUnit unit = parseDeltaUnit(options.rpe_delta_unit);
   for (const auto& [begin, end] : segments) {
-    const PoseTrajectory slice(aligned.begin() + static_cast<std::ptrdiff_t>(begin),
-                               aligned.begin() + static_cast<std::ptrdiff_t>(end));
+    const core::Trajectory slice(aligned.begin() + static_cast<std::ptrdiff_t>(begin),
+                                 aligned.begin() + static_cast<std::ptrdiff_t>(end));
     for (const auto& [i, j] : rpePairs(slice, options.rpe_delta, unit)) {
       pairs.emplace_back(begin + i, begin + j);
     }
@@ -317,12 +310,12 @@ SourceMetrics evaluateSource(const PoseTrajectory& truth,
   return m;
 }
 
-RunMetrics evaluate(const PoseTrajectory& truth,
+RunMetrics evaluate(const core::Trajectory& truth,
                     const std::map<std::string, std::vector<SourceEstimate>>& sources,
                     const EvalOptions& options) {
   RunMetrics run;
   run.truth_poses = truth.size();
-  run.truth_track_length_m = trackLength(truth);
+  run.truth_track_length_m = core::trackLength(truth);
   run.truth_duration_s = truth.empty() ? 0.0 : truth.back().t_s - truth.front().t_s;
   for (const auto& [name, estimates] : sources) {
     run.sources[name] = evaluateSource(truth, estimates, options);
@@ -331,148 +324,21 @@ RunMetrics evaluate(const PoseTrajectory& truth,
   return run;
 }
 
-std::map<std::string, std::string> defaultSourceChannels() {
-  return {{"POSE_PPA", "ppa"}, {"POSE_VO_FEATURE", "vo_feature"}, {"POSE_VO_DIRECT", "vo_direct"}};
-}
-
-TrajectoryCollector::TrajectoryCollector(std::map<std::string, std::string> source_channels)
-    : source_channels_(std::move(source_channels)) {}
-
-namespace {
-
-// The pose of a pose_t; nothing for a non-finite position or a quaternion that is
-// not a rotation.
-std::optional<StampedPose> stampedPose(const nadir::pose_t& message) {
-  StampedPose pose;
-  pose.t_s = static_cast<double>(message.utime) / 1e6;
-  pose.p_m = Eigen::Vector3d(message.pos[0], message.pos[1], message.pos[2]);
-  if (!pose.p_m.allFinite()) return std::nullopt;
-  try {
-    pose.q = core::quaternionFromWire(message.orientation);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  return pose;
-}
-
-}  // namespace
-
-bool TrajectoryCollector::add(const std::string& channel, const void* data, std::size_t size) {
-  if (channel == kTruthChannel) {
-    nadir::pose_t message;
-    const std::optional<StampedPose> pose =
-        core::decodeMessage(data, size, message) ? stampedPose(message) : std::nullopt;
-    if (pose) {
-      truth_.push_back(*pose);
-    } else {
-      ++undecodable_[channel];
-    }
-    return true;
-  }
-  const auto source = source_channels_.find(channel);
-  if (source == source_channels_.end()) return false;
-  nadir::vo_estimate_t message;
-  if (!core::decodeMessage(data, size, message)) {
-    ++undecodable_[channel];
-    return true;
-  }
-  SourceEstimate estimate;
-  estimate.t_s = static_cast<double>(message.utime) / 1e6;
-  estimate.status = message.status;
-  if (estimate.status == SourceEstimate::kTracking) {
-    const std::optional<StampedPose> pose = stampedPose(message.pose);
-    if (!pose) {
-      ++undecodable_[channel];
-      return true;
-    }
-    estimate.p_m = pose->p_m;
-    estimate.q = pose->q;
-  }
-  sources_[source->second].push_back(estimate);
-  return true;
-}
-
-std::string TrajectoryCollector::undecodableReport() const {
-  std::string report;
-  for (const auto& [channel, count] : undecodable_) {
-    appendNote(report, std::to_string(count) + " undecodable or invalid message" +
-                           (count == 1 ? "" : "s") + " on " + channel);
-  }
-  return report;
-}
-
-LogTrajectories TrajectoryCollector::trajectories() const {
-  LogTrajectories out;
-  out.truth = truth_;
-  out.sources = sources_;
-  out.damage = undecodableReport();
-  std::stable_sort(out.truth.begin(), out.truth.end(),
-                   [](const StampedPose& a, const StampedPose& b) { return a.t_s < b.t_s; });
-  const auto duplicate =
-      std::unique(out.truth.begin(), out.truth.end(),
-                  [](const StampedPose& a, const StampedPose& b) { return a.t_s == b.t_s; });
-  out.truth.erase(duplicate, out.truth.end());
-  for (auto& [name, estimates] : out.sources) {
-    std::stable_sort(
-        estimates.begin(), estimates.end(),
-        [](const SourceEstimate& a, const SourceEstimate& b) { return a.t_s < b.t_s; });
-  }
-  return out;
-}
-
-LogTrajectories readRunLog(const std::string& log_path,
-                           const std::map<std::string, std::string>& source_channels) {
-  TrajectoryCollector collector(source_channels);
-  std::size_t events = 0;
-  std::string reader_damage;
-  try {
-    core::LcmLogReader reader(log_path);
-    while (const std::optional<core::LogEvent> event = reader.next()) {
-      ++events;
-      collector.add(event->channel, event->data.data(), event->data.size());
-    }
-    reader_damage = reader.damageReport();
-  } catch (const core::LogError& error) {
-    throw EvalError(error.what());
-  }
-  if (events == 0) throw EvalError(log_path + ": the log is empty (no events)");
-  if (collector.truthPoses() == 0) {
-    throw EvalError(log_path + ": no truth: no valid pose_t on " + kTruthChannel + " among " +
-                    std::to_string(events) + " events");
-  }
-  LogTrajectories out = collector.trajectories();
-  std::string damage = std::move(reader_damage);
-  if (!out.damage.empty()) appendNote(damage, out.damage);
-  out.damage = std::move(damage);
-  return out;
-}
-
-PoseTrajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates) {
-  PoseTrajectory trajectory;
-  for (const SourceEstimate& e : estimates) {
-    if (e.status != SourceEstimate::kTracking) continue;
-    // TUM needs strictly increasing stamps: keep the first of equal stamps.
-    if (!trajectory.empty() && e.t_s <= trajectory.back().t_s) continue;
-    trajectory.push_back(StampedPose{e.t_s, e.p_m, e.q.normalized()});
-  }
-  return trajectory;
-}
-
 RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
-                             const EvalOptions& options) {
+                             const EvalOptions& options, const std::string& truth_channel) {
   RunEvaluation run;
-  run.recorded = readRunLog(log_path);
+  run.recorded = logs::readRunLog(log_path, truth_channel);
   run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options);
   const std::filesystem::path dir(out_dir.empty() ? std::string(".") : out_dir);
   run.metrics_path = (dir / "metrics.json").string();
   writeMetricsJson(run.metrics_path, run.metrics, options);
   run.tum_paths.push_back((dir / "truth.tum").string());
-  writeTum(run.tum_paths.back(), run.recorded.truth);
+  core::writeTum(run.tum_paths.back(), run.recorded.truth);
   for (const auto& [name, estimates] : run.recorded.sources) {
-    PoseTrajectory tracked = trackingTrajectory(estimates);
+    core::Trajectory tracked = logs::trackingTrajectory(estimates);
     if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
     run.tum_paths.push_back((dir / (name + ".tum")).string());
-    writeTum(run.tum_paths.back(), tracked);
+    core::writeTum(run.tum_paths.back(), tracked);
     run.tracked.emplace(name, std::move(tracked));
   }
   return run;

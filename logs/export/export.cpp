@@ -14,16 +14,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/bus.h"
 #include "core/clock.h"
-#include "core/frames.h"
 #include "core/lcm_log.h"
-#include "logs/eval/trajectory.h"
-#include "nadir/camera_info_t.hpp"
-#include "nadir/image_t.hpp"
-#include "nadir/imu_t.hpp"
-#include "nadir/pose_t.hpp"
-#include "nodes/camera/camera_messages.h"
+#include "core/trajectory.h"
+#include "lcmtypes/codec.h"
 
 namespace nadir::dataset {
 namespace fs = std::filesystem;
@@ -34,22 +28,8 @@ namespace {
 // gap means truth is missing there (a damaged log), not a slow truth stream.
 constexpr std::int64_t kMaxTruthGapUs = 500'000;
 
-struct ImuSample {
-  std::int64_t utime = 0;
-  Eigen::Vector3d gyro_rps = Eigen::Vector3d::Zero();
-  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
-};
-
-// One pose_t of the truth channel: T_world_body (world local NED, body FRD).
-struct TruthSample {
-  std::int64_t utime = 0;
-  Eigen::Vector3d p_body_in_world_m = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d v_world_mps = Eigen::Vector3d::Zero();
-};
-
 struct Calibration {
-  nadir::camera_info_t info;
+  msg::CameraInfo info;
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
 };
 
@@ -57,8 +37,8 @@ struct Calibration {
 struct Scan {
   std::optional<Calibration> calibration;
   std::optional<std::int64_t> calibration_changed_utime;
-  std::vector<TruthSample> truth;
-  std::vector<ImuSample> imu;
+  std::vector<msg::Pose> truth;  // T_world_body (world local NED, body FRD)
+  std::vector<msg::Imu> imu;
   std::int64_t camera_images = 0;
   std::int64_t camera_other_messages = 0;
   std::map<std::string, std::int64_t> image_channels;
@@ -70,19 +50,14 @@ struct Scan {
   std::string damage;
 };
 
-// The LCM fingerprint (the first 8 bytes, big-endian) says which type a message is.
-template <class Msg>
-bool hasFingerprint(const std::vector<std::uint8_t>& data) {
-  if (data.size() < 8) return false;
-  std::uint64_t hash = 0;
-  for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[static_cast<std::size_t>(i)];
-  return static_cast<std::int64_t>(hash) == Msg::getHash();
-}
-
-template <class Msg>
-bool decode(const core::LogEvent& event, Msg& message) {
-  return hasFingerprint<Msg>(event.data) &&
-         core::decodeMessage(event.data.data(), event.data.size(), message);
+// Decodes one event as T; nothing if it is not a valid T.
+template <class T>
+std::optional<T> decodeEvent(const core::LogEvent& event) {
+  try {
+    return msg::decode<T>(event.data);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
 }
 
 std::string plural(std::int64_t count, const std::string& word) {
@@ -99,49 +74,11 @@ std::string channelList(const std::map<std::string, std::int64_t>& channels,
   return text;
 }
 
-bool sameCalibration(const nadir::camera_info_t& a, const nadir::camera_info_t& b) {
+bool sameCalibration(const msg::CameraInfo& a, const msg::CameraInfo& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
          a.cx == b.cx && a.cy == b.cy && a.distortion_model == b.distortion_model &&
-         a.distortion == b.distortion &&
-         std::equal(std::begin(a.position_cam_in_body_m), std::end(a.position_cam_in_body_m),
-                    std::begin(b.position_cam_in_body_m)) &&
-         std::equal(std::begin(a.orientation_body_cam), std::end(a.orientation_body_cam),
-                    std::begin(b.orientation_body_cam));
-}
-
-std::optional<Calibration> calibrationFrom(const nadir::camera_info_t& info) {
-  Calibration calibration;
-  calibration.info = info;
-  try {
-    calibration.T_body_cam.linear() =
-        core::quaternionFromWire(info.orientation_body_cam).toRotationMatrix();
-  } catch (const std::invalid_argument&) {
-    return std::nullopt;
-  }
-  calibration.T_body_cam.translation() =
-      Eigen::Vector3d(info.position_cam_in_body_m[0], info.position_cam_in_body_m[1],
-                      info.position_cam_in_body_m[2]);
-  if (!calibration.T_body_cam.matrix().allFinite() || !std::isfinite(info.fx) ||
-      !std::isfinite(info.fy) || !std::isfinite(info.cx) || !std::isfinite(info.cy) ||
-      info.fx <= 0 || info.fy <= 0 || info.width <= 0 || info.height <= 0) {
-    return std::nullopt;
-  }
-  return calibration;
-}
-
-std::optional<TruthSample> truthFrom(const nadir::pose_t& pose) {
-  TruthSample sample;
-  sample.utime = pose.utime;
-  sample.p_body_in_world_m = Eigen::Vector3d(pose.pos[0], pose.pos[1], pose.pos[2]);
-  sample.v_world_mps = Eigen::Vector3d(pose.vel[0], pose.vel[1], pose.vel[2]);
-  if (!sample.p_body_in_world_m.allFinite()) return std::nullopt;
-  try {
-    sample.q_world_body = core::quaternionFromWire(pose.orientation);
-  } catch (const std::invalid_argument&) {
-    return std::nullopt;
-  }
-  if (!sample.v_world_mps.allFinite()) sample.v_world_mps.setZero();
-  return sample;
+         a.distortion == b.distortion && a.p_cam_in_body_m == b.p_cam_in_body_m &&
+         a.q_body_cam.coeffs() == b.q_body_cam.coeffs();
 }
 
 // Sorts by utime and keeps the first of samples that share a time; returns how many went.
@@ -170,50 +107,41 @@ Scan scanLog(const ExportOptions& options, const std::string& info_channel) {
   try {
     while (auto event = reader->next()) {
       ++scan.all_channels[event->channel];
-      if (hasFingerprint<nadir::image_t>(event->data)) ++scan.image_channels[event->channel];
-      if (hasFingerprint<nadir::camera_info_t>(event->data)) ++scan.info_channels[event->channel];
+      const bool image = msg::isType<msg::Image>(event->data.data(), event->data.size());
+      if (image) ++scan.image_channels[event->channel];
+      if (msg::isType<msg::CameraInfo>(event->data.data(), event->data.size())) {
+        ++scan.info_channels[event->channel];
+      }
       if (event->channel == options.camera_channel) {
-        if (hasFingerprint<nadir::image_t>(event->data)) {
+        if (image) {
           ++scan.camera_images;
         } else {
           ++scan.camera_other_messages;
         }
       }
       if (event->channel == info_channel) {
-        nadir::camera_info_t info;
-        std::optional<Calibration> calibration;
-        if (decode(*event, info)) calibration = calibrationFrom(info);
-        if (!calibration) {
+        const std::optional<msg::CameraInfo> info = decodeEvent<msg::CameraInfo>(*event);
+        if (!info) {
           ++scan.undecodable[info_channel];
         } else if (!scan.calibration) {
-          scan.calibration = calibration;
+          scan.calibration = Calibration{*info, info->T_body_cam()};
         } else if (!scan.calibration_changed_utime &&
-                   !sameCalibration(scan.calibration->info, info)) {
-          scan.calibration_changed_utime = info.utime;
+                   !sameCalibration(scan.calibration->info, *info)) {
+          scan.calibration_changed_utime = info->utime;
         }
       }
       if (event->channel == options.truth_channel) {
-        nadir::pose_t pose;
-        std::optional<TruthSample> sample;
-        if (decode(*event, pose)) sample = truthFrom(pose);
-        if (sample) {
-          scan.truth.push_back(*sample);
+        if (std::optional<msg::Pose> pose = decodeEvent<msg::Pose>(*event)) {
+          // EuRoC's ground truth holds the velocity; other systems may leave it unset.
+          if (!pose->v_ned_mps.allFinite()) pose->v_ned_mps.setZero();
+          scan.truth.push_back(*pose);
         } else {
           ++scan.undecodable[options.truth_channel];
         }
       }
       if (event->channel == options.imu_channel) {
-        nadir::imu_t imu;
-        if (decode(*event, imu)) {
-          ImuSample sample;
-          sample.utime = imu.utime;
-          sample.gyro_rps =
-              Eigen::Vector3d(imu.angular_velocity_rps[0], imu.angular_velocity_rps[1],
-                              imu.angular_velocity_rps[2]);
-          sample.accel_mps2 =
-              Eigen::Vector3d(imu.linear_acceleration_mps2[0], imu.linear_acceleration_mps2[1],
-                              imu.linear_acceleration_mps2[2]);
-          scan.imu.push_back(sample);
+        if (const std::optional<msg::Imu> imu = decodeEvent<msg::Imu>(*event)) {
+          scan.imu.push_back(*imu);
         } else {
           ++scan.undecodable[options.imu_channel];
         }
@@ -303,7 +231,7 @@ std::string listOf(const std::vector<double>& values) {
 }
 
 // The first `count` coefficients (zero-padded); a note if non-zero ones are cut.
-std::vector<double> firstCoefficients(const nadir::camera_info_t& info, std::size_t count,
+std::vector<double> firstCoefficients(const msg::CameraInfo& info, std::size_t count,
                                       const std::string& format_name,
                                       std::vector<std::string>& notes) {
   std::vector<double> coefficients(count, 0.0);
@@ -325,14 +253,11 @@ struct ImageRecord {
   double exposure_ms = 0.0;
 };
 
-double exposureMs(const nadir::image_t& image) {
-  for (const auto& entry : image.metadata) {
-    if (entry.key != "exposure_s") continue;
-    try {
-      const double seconds = std::stod(std::string(entry.value.begin(), entry.value.end()));
-      if (std::isfinite(seconds) && seconds > 0) return seconds * 1000.0;
-    } catch (const std::exception&) {
-    }
+double exposureMs(const msg::Image& image) {
+  try {
+    const double seconds = std::stod(image.metadataText("exposure_s"));
+    if (std::isfinite(seconds) && seconds > 0) return seconds * 1000.0;
+  } catch (const std::exception&) {
   }
   return 0.0;
 }
@@ -383,7 +308,7 @@ double cameraRateHz(const Context& context) {
   return span_s > 0 ? static_cast<double>(context.images.size() - 1) / span_s : 0.0;
 }
 
-double medianRateHz(const std::vector<ImuSample>& samples) {
+double medianRateHz(const std::vector<msg::Imu>& samples) {
   if (samples.size() < 2) return 0.0;
   std::vector<std::int64_t> dts;
   dts.reserve(samples.size() - 1);
@@ -404,21 +329,20 @@ void writeTumTrajectory(Context& context, const fs::path& path) {
   file << "# " + sourceLine(context) + ", truth from " + context.options.truth_channel + "\n";
   file << "# timestamp tx ty tz qx qy qz qw\n";
   std::int64_t missing = 0;
-  eval::PoseTrajectory truth;
-  for (const TruthSample& sample : context.scan.truth) {
-    truth.push_back(
-        {core::secondsFromUtime(sample.utime), sample.p_body_in_world_m, sample.q_world_body});
+  core::Trajectory truth;
+  for (const msg::Pose& sample : context.scan.truth) {
+    truth.push_back({core::secondsFromUtime(sample.utime), sample.p_ned_m, sample.q_world_body});
   }
   for (const ImageRecord& image : context.images) {
-    const auto body = eval::interpolate(truth, core::secondsFromUtime(image.utime),
+    const auto body = core::interpolate(truth, core::secondsFromUtime(image.utime),
                                         core::secondsFromUtime(kMaxTruthGapUs));
     if (!body) {
       ++missing;
       continue;
     }
     Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-    T_world_body.linear() = body->q.toRotationMatrix();
-    T_world_body.translation() = body->p_m;
+    T_world_body.linear() = body->q_world_body.toRotationMatrix();
+    T_world_body.translation() = body->p_ned_m;
     const Eigen::Isometry3d T_world_cam = T_world_body * context.calibration.T_body_cam;
     const Eigen::Vector3d p = T_world_cam.translation();
     const Eigen::Quaterniond q(T_world_cam.rotation());
@@ -451,14 +375,14 @@ std::string framesReadme(const Context& context, const std::string& layout,
          std::to_string(info.width) + "x" + std::to_string(info.height) + " px, fx " +
          number(info.fx) + ", fy " + number(info.fy) + ", cx " + number(info.cx) + ", cy " +
          number(info.cy) + " (pixel centres; the top-left pixel's centre is (0, 0))\n" +
-         "- distortion coefficients (model " + std::to_string(info.distortion_model) +
+         "- distortion coefficients (model " +
+         std::to_string(static_cast<int>(info.distortion_model)) +
          ": 0 none, 1 radial-tangential k1 k2 p1 p2 [k3], 2 equidistant k1 k2 k3 k4): " +
-         listOf(info.distortion) + "\n- T_body_cam: camera at " +
-         number(info.position_cam_in_body_m[0]) + ", " + number(info.position_cam_in_body_m[1]) +
-         ", " + number(info.position_cam_in_body_m[2]) +
+         listOf(info.distortion) + "\n- T_body_cam: camera at " + number(info.p_cam_in_body_m.x()) +
+         ", " + number(info.p_cam_in_body_m.y()) + ", " + number(info.p_cam_in_body_m.z()) +
          " m in the body frame, R_body_cam (w x y z) " +
-         listOf({info.orientation_body_cam[0], info.orientation_body_cam[1],
-                 info.orientation_body_cam[2], info.orientation_body_cam[3]}) +
+         listOf(
+             {info.q_body_cam.w(), info.q_body_cam.x(), info.q_body_cam.y(), info.q_body_cam.z()}) +
          "\n\nCounts: " + plural(context.summary.images, "image") + ", " +
          plural(context.summary.poses, "ground-truth pose") + ", " +
          plural(context.summary.imu_samples, "IMU sample") + ".\n";
@@ -478,7 +402,7 @@ void writeEuroc(Context& context) {
     csv.close();
     std::string model = "radial-tangential";
     std::vector<double> coefficients;
-    if (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT) {
+    if (info.distortion_model == msg::Distortion::EQUIDISTANT) {
       model = "equidistant";
       coefficients = firstCoefficients(info, 4, "EuRoC's equidistant model", notes);
     } else {
@@ -505,11 +429,12 @@ void writeEuroc(Context& context) {
     TextFile csv(mav / "imu0" / "data.csv");
     csv << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
            "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
-    for (const ImuSample& s : context.scan.imu) {
-      csv << nanosecondsText(s.utime) + "," + number(s.gyro_rps.x()) + "," +
-                 number(s.gyro_rps.y()) + "," + number(s.gyro_rps.z()) + "," +
-                 number(s.accel_mps2.x()) + "," + number(s.accel_mps2.y()) + "," +
-                 number(s.accel_mps2.z()) + "\n";
+    for (const msg::Imu& s : context.scan.imu) {
+      const Eigen::Vector3d& w = s.angular_velocity_rps;
+      const Eigen::Vector3d& a = s.linear_acceleration_mps2;
+      csv << nanosecondsText(s.utime) + "," + number(w.x()) + "," + number(w.y()) + "," +
+                 number(w.z()) + "," + number(a.x()) + "," + number(a.y()) + "," + number(a.z()) +
+                 "\n";
       ++context.summary.imu_samples;
     }
     csv.close();
@@ -536,13 +461,12 @@ void writeEuroc(Context& context) {
            "q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], "
            "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
            "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
-    for (const TruthSample& s : context.scan.truth) {
+    for (const msg::Pose& s : context.scan.truth) {
       const Eigen::Quaterniond& q = s.q_world_body;
-      csv << nanosecondsText(s.utime) + "," + number(s.p_body_in_world_m.x()) + "," +
-                 number(s.p_body_in_world_m.y()) + "," + number(s.p_body_in_world_m.z()) + "," +
-                 number(q.w()) + "," + number(q.x()) + "," + number(q.y()) + "," + number(q.z()) +
-                 "," + number(s.v_world_mps.x()) + "," + number(s.v_world_mps.y()) + "," +
-                 number(s.v_world_mps.z()) + ",0,0,0,0,0,0\n";
+      csv << nanosecondsText(s.utime) + "," + number(s.p_ned_m.x()) + "," + number(s.p_ned_m.y()) +
+                 "," + number(s.p_ned_m.z()) + "," + number(q.w()) + "," + number(q.x()) + "," +
+                 number(q.y()) + "," + number(q.z()) + "," + number(s.v_ned_mps.x()) + "," +
+                 number(s.v_ned_mps.y()) + "," + number(s.v_ned_mps.z()) + ",0,0,0,0,0,0\n";
       ++context.summary.poses;
     }
     csv.close();
@@ -595,13 +519,13 @@ std::string dsoCalibration(const Context& context) {
       number(info.fx) + " " + number(info.fy) + " " + number(info.cx) + " " + number(info.cy);
   auto& notes = context.summary.notes;
   switch (info.distortion_model) {
-    case nadir::camera_info_t::DISTORTION_RADTAN: {
+    case msg::Distortion::RADTAN: {
       const auto d = firstCoefficients(info, 4, "DSO's RadTan model", notes);
       // "crop": DSO undistorts to a pinhole image of the same size ("none" would skip that).
       return "RadTan " + k + " " + number(d[0]) + " " + number(d[1]) + " " + number(d[2]) + " " +
              number(d[3]) + "\n" + size + "crop\n" + size;
     }
-    case nadir::camera_info_t::DISTORTION_EQUIDISTANT: {
+    case msg::Distortion::EQUIDISTANT: {
       const auto d = firstCoefficients(info, 4, "DSO's EquiDistant model", notes);
       return "EquiDistant " + k + " " + number(d[0]) + " " + number(d[1]) + " " + number(d[2]) +
              " " + number(d[3]) + "\n" + size + "crop\n" + size;
@@ -647,7 +571,7 @@ void writeTum(Context& context) {
   list.close();
   const auto& info = context.calibration.info;
   std::vector<double> d;
-  if (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT) {
+  if (info.distortion_model == msg::Distortion::EQUIDISTANT) {
     d = firstCoefficients(info, 4, "equidistant", context.summary.notes);
     d.push_back(0.0);
     context.summary.notes.push_back(
@@ -655,15 +579,15 @@ void writeTum(Context& context) {
   } else {
     d = firstCoefficients(info, 5, "TUM's calibration line", context.summary.notes);
   }
-  writeText(context.out / "calibration.txt",
-            "# " + sourceLine(context) + "\n# " + std::to_string(info.width) + "x" +
-                std::to_string(info.height) + " px; model " +
-                (info.distortion_model == nadir::camera_info_t::DISTORTION_EQUIDISTANT
-                     ? "equidistant"
-                     : "radial-tangential (OpenCV)") +
-                "\n# fx fy cx cy d0 d1 d2 d3 d4\n" + number(info.fx) + " " + number(info.fy) + " " +
-                number(info.cx) + " " + number(info.cy) + " " + number(d[0]) + " " + number(d[1]) +
-                " " + number(d[2]) + " " + number(d[3]) + " " + number(d[4]) + "\n");
+  writeText(
+      context.out / "calibration.txt",
+      "# " + sourceLine(context) + "\n# " + std::to_string(info.width) + "x" +
+          std::to_string(info.height) + " px; model " +
+          (info.distortion_model == msg::Distortion::EQUIDISTANT ? "equidistant"
+                                                                 : "radial-tangential (OpenCV)") +
+          "\n# fx fy cx cy d0 d1 d2 d3 d4\n" + number(info.fx) + " " + number(info.fy) + " " +
+          number(info.cx) + " " + number(info.cy) + " " + number(d[0]) + " " + number(d[1]) + " " +
+          number(d[2]) + " " + number(d[3]) + " " + number(d[4]) + "\n");
   writeTumTrajectory(context, context.out / "groundtruth.txt");
   writeText(context.out / "README.md",
             framesReadme(context,
@@ -694,20 +618,22 @@ void writeImages(Context& context, const Layout& layout) {
   try {
     while (auto event = reader->next()) {
       if (event->channel != context.options.camera_channel) continue;
-      nadir::image_t message;
-      if (!hasFingerprint<nadir::image_t>(event->data)) continue;
-      cv::Mat pixels;
+      if (!msg::isType<msg::Image>(event->data.data(), event->data.size())) continue;
+      msg::Image message;
       try {
-        if (!core::decodeMessage(event->data.data(), event->data.size(), message)) {
-          throw std::invalid_argument("event " + std::to_string(event->event_number) +
-                                      " does not decode as image_t");
+        message = msg::decode<msg::Image>(event->data);
+      } catch (const msg::DecodeError& error) {
+        if (first_error.empty()) {
+          first_error = "event " + std::to_string(event->event_number) + ": " + error.what();
         }
-        pixels = camera::imageFromMessage(message);
-      } catch (const std::invalid_argument& error) {
+        ++undecodable;
+        continue;
+      } catch (const msg::InvalidMessage& error) {
         if (first_error.empty()) first_error = error.what();
         ++undecodable;
         continue;
       }
+      cv::Mat& pixels = message.pixels;
       // Every layout needs strictly increasing times (EuRoC and TUM name files by them).
       if (last_utime && message.utime <= *last_utime) {
         ++out_of_order;

@@ -1,8 +1,6 @@
 #include "nodes/camera/camera_node.h"
 
-#include <stdexcept>
-
-#include "nodes/camera/camera_messages.h"
+#include "lcmtypes/bus_io.h"
 
 namespace nadir::camera {
 
@@ -10,26 +8,27 @@ CameraNode::CameraNode(core::Bus& bus, const CameraNodeParams& params)
     : bus_(bus),
       scene_(params.world, params.tiles, params.renderer, params.targets),
       rig_(scene_.terrain, params.cameras) {
-  subscription_ = core::subscribe<nadir::pose_t>(
-      bus_, params.pose_channel, [this](const nadir::pose_t& pose) { onPose(pose); });
+  subscription_ = msg::subscribe<msg::Pose>(
+      bus_, params.pose_channel, [this](const msg::Pose& pose) { onPose(pose); },
+      [this](const std::string& reason) { dropPose(reason); });
 }
 
-void CameraNode::onPose(const nadir::pose_t& pose) {
-  Eigen::Isometry3d T_world_body;
-  try {
-    T_world_body = bodyPoseFromMessage(pose);
-  } catch (const std::invalid_argument& error) {
-    if (bad_poses_++ == 0) first_bad_pose_ = error.what();
-    return;
-  }
+void CameraNode::dropPose(const std::string& reason) {
+  if (bad_poses_++ == 0) first_bad_pose_ = reason;
+}
+
+void CameraNode::onPose(const msg::Pose& pose) {
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  T_world_body.linear() = pose.q_world_body.toRotationMatrix();
+  T_world_body.translation() = pose.p_ned_m;
   for (const CameraFrame& frame : rig_.onPose(pose.utime, T_world_body)) {
-    core::publish(bus_, frame.spec->channel,
-                  toImageMessage(frame.rendered, frame.spec->jpeg_quality));
+    msg::publish(bus_, frame.spec->channel,
+                 msg::Image{frame.rendered.utime, frame.rendered.image, frame.spec->jpeg_quality});
     // camera_info_t with the first frame, then once a second (and after a jump back).
     auto [last, first] = last_info_utime_.try_emplace(frame.name, pose.utime);
     if (first || pose.utime - last->second >= 1'000'000 || pose.utime < last->second) {
-      core::publish(bus_, frame.spec->info_channel,
-                    toCameraInfo(frame.name, *frame.spec, rig_.intrinsics(frame.name), pose.utime));
+      msg::publish(bus_, frame.spec->info_channel,
+                   cameraInfo(frame.name, *frame.spec, rig_.intrinsics(frame.name), pose.utime));
       last->second = pose.utime;
     }
     ++frames_;

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/bus.h"
-#include "nadir/pose_t.hpp"
+#include "lcmtypes/messages.h"
 #include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
 #include "nodes/camera/ground_scene.h"
@@ -28,7 +28,8 @@ class CameraNode {
   const std::string& firstBadPose() const { return first_bad_pose_; }
 
  private:
-  void onPose(const nadir::pose_t& pose);
+  void onPose(const msg::Pose& pose);
+  void dropPose(const std::string& reason);
 
   core::Bus& bus_;
   GroundScene scene_;

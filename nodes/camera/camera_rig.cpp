@@ -71,4 +71,25 @@ const render::CameraIntrinsics& CameraRig::intrinsics(const std::string& name) c
   return cameras_.at(name).renderer->intrinsics();
 }
 
+msg::CameraInfo cameraInfo(const std::string& name, const CameraSpec& spec,
+                           const render::CameraIntrinsics& intrinsics, std::int64_t utime) {
+  msg::CameraInfo info;
+  info.utime = utime;
+  info.camera_name = name;
+  info.width = intrinsics.width;
+  info.height = intrinsics.height;
+  info.fx = intrinsics.fx;
+  info.fy = intrinsics.fy;
+  info.cx = intrinsics.cx;
+  info.cy = intrinsics.cy;
+  info.distortion_model =
+      intrinsics.hasDistortion() ? msg::Distortion::RADTAN : msg::Distortion::NONE;
+  info.distortion.assign(intrinsics.distortion.begin(), intrinsics.distortion.end());
+  info.fps = spec.fps;
+  const Eigen::Isometry3d T_body_cam = spec.T_body_cam();
+  info.p_cam_in_body_m = T_body_cam.translation();
+  info.q_body_cam = Eigen::Quaterniond(T_body_cam.rotation());
+  return info;
+}
+
 }  // namespace nadir::camera

@@ -13,6 +13,7 @@
 
 #include "core/clock.h"
 #include "core/params.h"
+#include "lcmtypes/messages.h"
 #include "render/camera_renderer.h"
 #include "render/terrain_renderer.h"
 
@@ -66,5 +67,9 @@ class CameraRig {
   std::map<std::string, Camera> cameras_;
   std::int64_t last_utime_ = -1;
 };
+
+// The camera_info_t of a camera of the rig: its lens and mount, stamped utime.
+msg::CameraInfo cameraInfo(const std::string& name, const CameraSpec& spec,
+                           const render::CameraIntrinsics& intrinsics, std::int64_t utime);
 
 }  // namespace nadir::camera

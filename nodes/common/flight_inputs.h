@@ -11,8 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "core/bus.h"
-#include "nadir/attitude_t.hpp"
-#include "nadir/range_t.hpp"
+#include "lcmtypes/messages.h"
 
 namespace nadir::nodes {
 
@@ -27,8 +26,8 @@ class FlightInputs {
   std::optional<Eigen::Quaterniond> attitudeAt(std::int64_t utime) const;
 
  private:
-  std::optional<nadir::range_t> range_;
-  std::deque<nadir::attitude_t> attitudes_;
+  std::optional<msg::Range> range_;
+  std::deque<msg::Attitude> attitudes_;
   std::vector<core::Subscription> subscriptions_;
 };
 

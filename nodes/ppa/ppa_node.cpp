@@ -3,10 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/frames.h"
-#include "nadir/ppa_odometry_t.hpp"
-#include "nadir/target_detection_t.hpp"
-#include "nadir/vo_estimate_t.hpp"
-#include "nodes/camera/camera_messages.h"
+#include "lcmtypes/bus_io.h"
 
 namespace nadir::ppa {
 namespace {
@@ -61,12 +58,12 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
                                core::rotationBodyFromDownCamera()),
             std::move(targets_ne_m)),
       inputs_(bus, params.range_channel, params.attitude_channel) {
-  subscriptions_.push_back(core::subscribe<nadir::pose_t>(bus_, params_.truth_channel,
-                                                          [this](const nadir::pose_t& pose) {
-                                                            if (!first_truth_) first_truth_ = pose;
-                                                          }));
-  subscriptions_.push_back(core::subscribe<nadir::camera_info_t>(
-      bus_, params_.info_channel, [this](const nadir::camera_info_t& info) {
+  subscriptions_.push_back(
+      msg::subscribe<msg::Pose>(bus_, params_.truth_channel, [this](const msg::Pose& pose) {
+        if (!first_truth_) first_truth_ = pose;
+      }));
+  subscriptions_.push_back(msg::subscribe<msg::CameraInfo>(
+      bus_, params_.info_channel, [this](const msg::CameraInfo& info) {
         PpaCamera camera;
         camera.width = info.width;
         camera.height = info.height;
@@ -74,11 +71,12 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
         camera.fy = info.fy;
         camera.cx = info.cx;
         camera.cy = info.cy;
-        camera.R_body_cam = core::quaternionFromWire(info.orientation_body_cam).toRotationMatrix();
+        camera.R_body_cam = info.q_body_cam.toRotationMatrix();
         host_.setCamera(camera);
       }));
-  subscriptions_.push_back(core::subscribe<nadir::image_t>(
-      bus_, params_.image_channel, [this](const nadir::image_t& image) { onImage(image); }));
+  subscriptions_.push_back(msg::subscribe<msg::Image>(
+      bus_, params_.image_channel, [this](const msg::Image& image) { onImage(image); },
+      [this](const std::string& reason) { drop(reason); }));
 }
 
 double PpaNode::meanInstructionsPerFrame() const {
@@ -89,14 +87,8 @@ void PpaNode::drop(const std::string& reason) {
   if (dropped_images_++ == 0) first_drop_reason_ = reason;
 }
 
-void PpaNode::onImage(const nadir::image_t& image) {
-  cv::Mat gray;
-  try {
-    gray = camera::imageFromMessage(image);
-  } catch (const std::exception& error) {
-    drop(error.what());
-    return;
-  }
+void PpaNode::onImage(const msg::Image& image) {
+  cv::Mat gray = image.pixels;
   if (gray.type() != CV_8UC1 || gray.cols != kWidth || gray.rows != kHeight) {
     drop("the PPA needs 256x256 gray images, got " + std::to_string(gray.cols) + "x" +
          std::to_string(gray.rows) + " with " + std::to_string(gray.channels()) + " channel(s)");
@@ -104,8 +96,7 @@ void PpaNode::onImage(const nadir::image_t& image) {
   }
   if (!gray.isContinuous()) gray = gray.clone();
   if (!host_.initialised() && first_truth_ && first_truth_->utime <= image.utime) {
-    host_.initialise(
-        Eigen::Vector3d(first_truth_->pos[0], first_truth_->pos[1], first_truth_->pos[2]));
+    host_.initialise(first_truth_->p_ned_m);
   }
 
   array_.setLight(gray.ptr<std::uint8_t>());
@@ -136,21 +127,20 @@ void PpaNode::onImage(const nadir::image_t& image) {
   }
   const PpaHostOutput out = host_.update(input);
 
-  nadir::vo_estimate_t estimate{};
+  msg::VoEstimate estimate;
   estimate.utime = image.utime;
-  estimate.source = "ppa";
-  estimate.status = out.status == PpaStatus::kTracking ? nadir::vo_estimate_t::STATUS_TRACKING
-                    : out.status == PpaStatus::kLost   ? nadir::vo_estimate_t::STATUS_LOST
-                                                       : nadir::vo_estimate_t::STATUS_INITIALIZING;
-  estimate.pose.utime = image.utime;
-  for (int i = 0; i < 3; ++i) estimate.pose.pos[i] = out.p_ned_m[i];
-  core::quaternionToWire(out.q_world_body, estimate.pose.orientation);
+  estimate.source = kSourceName;
+  estimate.status = out.status == PpaStatus::kTracking ? msg::VoStatus::TRACKING
+                    : out.status == PpaStatus::kLost   ? msg::VoStatus::LOST
+                                                       : msg::VoStatus::INITIALIZING;
+  estimate.p_ned_m = out.p_ned_m;
+  estimate.q_world_body = out.q_world_body;
   estimate.num_features = vo.keyframe_edge_count;
   estimate.num_resets = 0;
   estimate.processing_time_s = static_cast<double>(instructions) / params_.chip_instruction_rate_hz;
-  core::publish(bus_, params_.pose_channel, estimate);
+  msg::publish(bus_, params_.pose_channel, estimate);
 
-  nadir::ppa_odometry_t odometry{};
+  msg::PpaOdometry odometry;
   odometry.utime = image.utime;
   odometry.frame_index = static_cast<std::int64_t>(frames_ - 1);
   odometry.translation_x_px = vo.translation_x_px;
@@ -161,12 +151,12 @@ void PpaNode::onImage(const nadir::image_t& image) {
   odometry.new_keyframe = vo.new_keyframe;
   odometry.keyframe_edge_count = vo.keyframe_edge_count;
   odometry.instruction_count = static_cast<std::int64_t>(instructions);
-  core::publish(bus_, params_.odometry_channel, odometry);
+  msg::publish(bus_, params_.odometry_channel, odometry);
 
   if (target) {
-    nadir::target_detection_t detection{};
+    msg::TargetDetection detection;
     detection.utime = image.utime;
-    detection.kind = nadir::target_detection_t::KIND_CONCENTRIC;
+    detection.kind = msg::TargetKind::CONCENTRIC;
     detection.detected = target->detected;
     detection.num_boundaries = params_.target.boundaries;
     if (target->detected) {
@@ -177,8 +167,7 @@ void PpaNode::onImage(const nadir::image_t& image) {
       detection.center_x_px = target->center_x_px;
       detection.center_y_px = target->center_y_px;
     }
-    detection.num_points = 0;
-    core::publish(bus_, params_.target_channel, detection);
+    msg::publish(bus_, params_.target_channel, detection);
   }
 }
 

@@ -14,9 +14,8 @@
 #include <Eigen/Core>
 
 #include "core/bus.h"
-#include "nadir/camera_info_t.hpp"
-#include "nadir/image_t.hpp"
-#include "nadir/pose_t.hpp"
+#include "lcmtypes/image.h"
+#include "lcmtypes/messages.h"
 #include "nodes/common/flight_inputs.h"
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/ppa_host.h"
@@ -25,6 +24,9 @@
 #include "nodes/ppa/visual_odometry.h"
 
 namespace nadir::ppa {
+
+// The node's name: its scenario group, its source name in vo_estimate_t and the metrics.
+inline constexpr char kSourceName[] = "ppa";
 
 class PpaNode {
  public:
@@ -39,7 +41,7 @@ class PpaNode {
   double meanInstructionsPerFrame() const;
 
  private:
-  void onImage(const nadir::image_t& image);
+  void onImage(const msg::Image& image);
   void drop(const std::string& reason);
 
   core::Bus& bus_;
@@ -49,7 +51,7 @@ class PpaNode {
   TargetExtractor extractor_;
   PpaHost host_;
   nodes::FlightInputs inputs_;
-  std::optional<nadir::pose_t> first_truth_;
+  std::optional<msg::Pose> first_truth_;
   std::uint64_t frames_ = 0;
   std::uint64_t dropped_images_ = 0;
   std::uint64_t instructions_ = 0;

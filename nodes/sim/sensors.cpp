@@ -173,6 +173,8 @@ RangeSample RangefinderModel::sample(const VehicleState& state, const terrain::W
   RangeSample out;
   out.utime = state.utime;
   out.direction_body = direction_body_;
+  out.min_range_m = params_.min_range_m;
+  out.max_range_m = params_.max_range_m;
   if (true_range_m < 0.0) {
     out.status = RangeStatus::OUT_OF_RANGE;
     out.range_m = params_.max_range_m;
@@ -274,7 +276,16 @@ BaroSample BarometerModel::sample(const VehicleState& state, const core::LocalNe
   out.utime = state.utime;
   out.altitude_m =
       frame.origin().alt_m - state.p_ned_m.z() + bias_m_ + noise_.normal(params_.noise_sigma_m);
+  out.pressure_pa = standardAtmospherePressure_pa(out.altitude_m);
   return out;
+}
+
+double standardAtmospherePressure_pa(double altitude_m) {
+  constexpr double kTropopause_m = 11000.0;
+  if (altitude_m <= kTropopause_m) {
+    return 101325.0 * std::pow(1.0 - 2.25577e-5 * altitude_m, 5.25588);
+  }
+  return 22632.06 * std::exp(-1.576883e-4 * (altitude_m - kTropopause_m));
 }
 
 }  // namespace nadir::sim

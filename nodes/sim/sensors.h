@@ -1,6 +1,6 @@
 #pragma once
 // Sensor models of the simulator: IMU, rangefinder, GPS and barometer. Plain
-// structs in, plain structs out, no LCM (the sim node wires them to messages).
+// structs in, the messages' plain structs (lcmtypes/messages.h) out, no LCM.
 //
 // Every model is deterministic: it owns a std::mt19937_64 seeded from its
 // params (a fixed default seed) and draws Gaussian noise with its own
@@ -22,6 +22,7 @@
 #include "core/clock.h"
 #include "core/geodesy.h"
 #include "core/params.h"
+#include "lcmtypes/messages.h"
 #include "nodes/sim/noise.h"
 #include "nodes/sim/vehicle_state.h"
 #include "terrain/world.h"
@@ -43,13 +44,7 @@ struct ImuParams {
   void visit(core::ParamVisitor& v);
 };
 
-struct ImuSample {
-  std::int64_t utime = 0;
-  // Body FRD, rad/s.
-  Eigen::Vector3d angular_velocity_rps = Eigen::Vector3d::Zero();
-  // Specific force in body FRD, m/s^2: a level vehicle at rest reads (0, 0, -g).
-  Eigen::Vector3d linear_acceleration_mps2 = Eigen::Vector3d::Zero();
-};
+using ImuSample = msg::Imu;
 
 // Gyro and accelerometer: truth + bias + white noise. The white noise has the
 // per-sample sigma density * sqrt(rate_hz); the biases start at the initial
@@ -92,17 +87,11 @@ struct RangefinderParams {
   void visit(core::ParamVisitor& v);
 };
 
-enum class RangeStatus { VALID, TOO_CLOSE, OUT_OF_RANGE };
+using RangeStatus = msg::RangeStatus;
 
-struct RangeSample {
-  std::int64_t utime = 0;
-  // Measured distance from the body origin along direction_body, m. With
-  // TOO_CLOSE it is min_range_m, with OUT_OF_RANGE max_range_m (no noise).
-  double range_m = 0.0;
-  RangeStatus status = RangeStatus::OUT_OF_RANGE;
-  // Unit direction of the beam in body FRD.
-  Eigen::Vector3d direction_body = Eigen::Vector3d::UnitZ();
-};
+// With TOO_CLOSE the range is min_range_m, with OUT_OF_RANGE max_range_m (no
+// noise); the sample carries the model's limits.
+using RangeSample = msg::Range;
 
 // A beam from the body origin along direction_body to the ground of a
 // terrain::World. The first crossing is found by marching along the ray in
@@ -146,21 +135,10 @@ struct GpsParams {
   void visit(core::ParamVisitor& v);
 };
 
-enum class GpsFix { NONE, FIX_3D };
+// Zero position and accuracy without a fix (NONE); the model gives NONE or FIX_3D.
+using GpsFix = msg::GpsFix;
 
-struct GpsSample {
-  std::int64_t utime = 0;
-  // WGS-84; alt_m above the ellipsoid. Zero without a fix.
-  double lat_rad = 0.0;
-  double lon_rad = 0.0;
-  double alt_m = 0.0;
-  Eigen::Vector3d velocity_ned_mps = Eigen::Vector3d::Zero();
-  // 1-sigma error per horizontal axis and vertically, m. Zero without a fix.
-  double horizontal_accuracy_m = 0.0;
-  double vertical_accuracy_m = 0.0;
-  int num_satellites = 0;
-  GpsFix fix = GpsFix::NONE;
-};
+using GpsSample = msg::Gps;
 
 // Position (white noise in metres, north/east with horizontal_sigma_m, down
 // with vertical_sigma_m, converted exactly with the LocalNedFrame) and NED
@@ -191,11 +169,14 @@ struct BarometerParams {
   void visit(core::ParamVisitor& v);
 };
 
-struct BaroSample {
-  std::int64_t utime = 0;
-  // Altitude, m: the origin's height above the ellipsoid minus the down coordinate.
-  double altitude_m = 0.0;
-};
+// The altitude is the origin's height above the ellipsoid minus the down
+// coordinate; pressure_pa is standardAtmospherePressure_pa of it.
+using BaroSample = msg::Baro;
+
+// Static pressure of the ICAO standard atmosphere, Pa, at altitude_m:
+// troposphere p = 101325 (1 - 2.25577e-5 h)^5.25588 up to 11 km, then the
+// isothermal layer p = 22632.06 exp(-1.576883e-4 (h - 11000)) (valid to 20 km).
+double standardAtmospherePressure_pa(double altitude_m);
 
 // Altitude with white noise and a bias random walk (sigma * sqrt(dt) per call,
 // dt from the utime difference; none at the first call).

@@ -4,7 +4,9 @@
 #include <cctype>
 #include <filesystem>
 
-#include "nodes/sim/sim_messages.h"
+#include "lcmtypes/bus_io.h"
+#include "logs/flight_log.h"
+#include "nodes/sim/nav_truth.h"
 
 namespace nadir::sim {
 namespace {
@@ -18,8 +20,8 @@ std::string lowerExtension(const std::string& path) {
 
 }  // namespace
 
-std::optional<Trajectory> loadFlight(const FlightParams& params, const core::LocalNedFrame& frame,
-                                     std::string* warning) {
+std::optional<FlightReplay> loadFlight(const FlightParams& params, const core::LocalNedFrame& frame,
+                                       std::string* warning) {
   if (params.path.empty()) return std::nullopt;
   std::string format = params.format;
   if (format == "auto") {
@@ -28,10 +30,10 @@ std::optional<Trajectory> loadFlight(const FlightParams& params, const core::Loc
              : extension == ".csv"                      ? "csv"
                                                         : "lcm";
   }
-  if (format == "tum") return readTumTrajectory(params.path);
-  if (format == "csv") return readFlightCsv(params.path, frame);
-  FlightLogStats stats;
-  Trajectory flight = readFlightLog(
+  if (format == "tum") return FlightReplay(core::readTum(params.path), params.path);
+  if (format == "csv") return FlightReplay(core::readFlightCsv(params.path, frame), params.path);
+  logs::FlightLogStats stats;
+  core::Trajectory flight = logs::readFlightLog(
       params.path, {params.pose_channel, params.position_channel, params.attitude_channel}, frame,
       &stats);
   if (warning != nullptr) {
@@ -43,29 +45,25 @@ std::optional<Trajectory> loadFlight(const FlightParams& params, const core::Loc
                   " undecodable or invalid messages skipped";
     }
   }
-  return flight;
+  return FlightReplay(std::move(flight), params.path);
 }
 
 SimPublisher::SimPublisher(core::Bus& bus, const SimParams& params, const Simulator& simulator)
     : bus_(bus), params_(params), simulator_(simulator) {}
 
-template <class Msg>
-void SimPublisher::send(const std::string& channel, const Msg& message) {
-  core::publish(bus_, channel, message);
+template <class T>
+void SimPublisher::send(const std::string& channel, const T& message) {
+  msg::publish(bus_, channel, message);
   ++counts_[channel];
 }
 
 void SimPublisher::publish(const SimOutput& output) {
   const SensorsParams& sensors = params_.sensors;
-  send(params_.truth.channel, toPoseMessage(output.truth));
-  if (output.imu) send(sensors.imu.channel, toImuMessage(*output.imu));
-  if (output.range) {
-    send(sensors.rangefinder.channel,
-         toRangeMessage(*output.range, sensors.rangefinder.model.min_range_m,
-                        sensors.rangefinder.model.max_range_m));
-  }
-  if (output.gps) send(sensors.gps.channel, toGpsMessage(*output.gps));
-  if (output.baro) send(sensors.barometer.channel, toBaroMessage(*output.baro));
+  send(params_.truth.channel, output.truth);
+  if (output.imu) send(sensors.imu.channel, *output.imu);
+  if (output.range) send(sensors.rangefinder.channel, *output.range);
+  if (output.gps) send(sensors.gps.channel, *output.gps);
+  if (output.baro) send(sensors.barometer.channel, *output.baro);
   if (output.nav_due) {
     const NavMessages nav =
         toNavMessages(output.truth, simulator_.frame(), simulator_.startAltitude_m());

@@ -10,18 +10,18 @@
 
 #include "core/bus.h"
 #include "core/geodesy.h"
+#include "nodes/sim/flight_replay.h"
 #include "nodes/sim/sim_params.h"
 #include "nodes/sim/simulator.h"
-#include "nodes/sim/trajectory.h"
 
 namespace nadir::sim {
 
 // The recorded flight of params.path, or nothing if the path is empty. The
 // format is taken from the extension with "auto" (.tum or .txt: TUM, .csv:
-// flight CSV, anything else: LCM log). Throws TrajectoryError naming the file.
-// A damaged LCM log is used up to the damage and *warning says so.
-std::optional<Trajectory> loadFlight(const FlightParams& params, const core::LocalNedFrame& frame,
-                                     std::string* warning = nullptr);
+// flight CSV, anything else: LCM log). Throws core::TrajectoryError naming the
+// file. A damaged LCM log is used up to the damage and *warning says so.
+std::optional<FlightReplay> loadFlight(const FlightParams& params, const core::LocalNedFrame& frame,
+                                       std::string* warning = nullptr);
 
 class SimPublisher {
  public:
@@ -32,8 +32,8 @@ class SimPublisher {
   const std::map<std::string, std::int64_t>& counts() const { return counts_; }
 
  private:
-  template <class Msg>
-  void send(const std::string& channel, const Msg& message);
+  template <class T>
+  void send(const std::string& channel, const T& message);
 
   core::Bus& bus_;
   SimParams params_;

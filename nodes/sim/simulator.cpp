@@ -66,7 +66,7 @@ ResolvedRoute resolveRoute(const SimParams& params, const terrain::World& world,
 }
 
 Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::World> world,
-                     const core::LocalNedFrame& frame, std::optional<Trajectory> flight)
+                     const core::LocalNedFrame& frame, std::optional<FlightReplay> flight)
     : params_(params), world_(std::move(world)), frame_(frame), flight_(std::move(flight)) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "simulation");
   const double step_s = 1.0 / params_.truth.rate_hz;

@@ -12,9 +12,9 @@
 #include <Eigen/Core>
 
 #include "core/geodesy.h"
+#include "nodes/sim/flight_replay.h"
 #include "nodes/sim/sensors.h"
 #include "nodes/sim/sim_params.h"
-#include "nodes/sim/trajectory.h"
 #include "nodes/sim/vehicles.h"
 #include "terrain/world.h"
 
@@ -51,7 +51,7 @@ class Simulator {
   // route. Throws core::ParamError for parameters that cannot be flown (an
   // unreachable waypoint among them), naming the key.
   Simulator(const SimParams& params, std::shared_ptr<const terrain::World> world,
-            const core::LocalNedFrame& frame, std::optional<Trajectory> flight = std::nullopt);
+            const core::LocalNedFrame& frame, std::optional<FlightReplay> flight = std::nullopt);
 
   // The first call gives the initial state; each later call advances one step
   // of 1 / truth.rate_hz.
@@ -72,7 +72,7 @@ class Simulator {
   SimParams params_;
   std::shared_ptr<const terrain::World> world_;
   core::LocalNedFrame frame_;
-  std::optional<Trajectory> flight_;
+  std::optional<FlightReplay> flight_;
   ResolvedRoute route_;
   std::variant<std::monostate, FixedWing, Multirotor, Rover> vehicle_;
   std::int64_t step_us_ = 0;

@@ -6,8 +6,7 @@
 #include <sstream>
 
 #include "core/frames.h"
-#include "nadir/vo_estimate_t.hpp"
-#include "nodes/camera/camera_messages.h"
+#include "lcmtypes/bus_io.h"
 
 namespace nadir::vo {
 void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
@@ -38,40 +37,35 @@ VoFeatureNode::VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params)
       params_(params),
       vo_(params.vo),
       inputs_(bus, params.range_channel, params.attitude_channel) {
-  subscriptions_.push_back(core::subscribe<nadir::pose_t>(
-      bus_, params_.truth_channel, [this](const nadir::pose_t& pose) {
+  subscriptions_.push_back(
+      msg::subscribe<msg::Pose>(bus_, params_.truth_channel, [this](const msg::Pose& pose) {
         if (started_) return;
-        try {
-          vo_.setStartPose(camera::bodyPoseFromMessage(pose));
-          started_ = true;
-        } catch (const std::invalid_argument&) {
-        }
+        Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+        T_world_body.linear() = pose.q_world_body.toRotationMatrix();
+        T_world_body.translation() = pose.p_ned_m;
+        vo_.setStartPose(T_world_body);
+        started_ = true;
       }));
-  subscriptions_.push_back(core::subscribe<nadir::camera_info_t>(
-      bus_, params_.info_channel, [this](const nadir::camera_info_t& info) {
+  subscriptions_.push_back(msg::subscribe<msg::CameraInfo>(
+      bus_, params_.info_channel, [this](const msg::CameraInfo& info) {
         if (!info_ || info_->width != info.width || info_->height != info.height ||
-            info_->fx != info.fx || info_->num_distortion != info.num_distortion) {
+            info_->fx != info.fx || info_->distortion.size() != info.distortion.size()) {
           undistort_map_x_.release();
         }
         info_ = info;
       }));
-  subscriptions_.push_back(core::subscribe<nadir::image_t>(
-      bus_, params_.image_channel, [this](const nadir::image_t& image) { onImage(image); }));
+  subscriptions_.push_back(msg::subscribe<msg::Image>(
+      bus_, params_.image_channel, [this](const msg::Image& image) { onImage(image); },
+      [this](const std::string& reason) { drop(reason); }));
 }
 
 void VoFeatureNode::drop(const std::string& reason) {
   if (dropped_images_++ == 0) first_drop_reason_ = reason;
 }
 
-void VoFeatureNode::onImage(const nadir::image_t& image) {
+void VoFeatureNode::onImage(const msg::Image& image) {
   if (!info_ || !started_) return;  // the lens and the start pose come first
-  cv::Mat frame;
-  try {
-    frame = camera::imageFromMessage(image);
-  } catch (const std::exception& error) {
-    drop(error.what());
-    return;
-  }
+  const cv::Mat& frame = image.pixels;
   if (frame.cols != info_->width || frame.rows != info_->height) {
     drop("image " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
          " does not match camera_info_t's " + std::to_string(info_->width) + "x" +
@@ -85,10 +79,7 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
     gray = frame;
   }
   const cv::Matx33d K(info_->fx, 0, info_->cx, 0, info_->fy, info_->cy, 0, 0, 1);
-  bool distorted = false;
-  for (int i = 0; i < info_->num_distortion; ++i)
-    distorted = distorted || info_->distortion[i] != 0.0;
-  if (distorted) {
+  if (info_->distorted()) {
     if (undistort_map_x_.empty()) {
       const std::vector<double> coefficients(info_->distortion.begin(), info_->distortion.end());
       cv::initUndistortRectifyMap(K, coefficients, cv::noArray(), K, gray.size(), CV_32FC1,
@@ -104,7 +95,7 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
   input.utime = image.utime;
   input.gray = gray;
   input.K = K;
-  input.R_body_cam = core::quaternionFromWire(info_->orientation_body_cam).toRotationMatrix();
+  input.R_body_cam = info_->q_body_cam.toRotationMatrix();
   // The rangefinder looks along the body's down axis.
   input.range_m = inputs_.validRange_m();
   input.range_ray_cam = input.R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
@@ -117,21 +108,18 @@ void VoFeatureNode::onImage(const nadir::image_t& image) {
   processing_s_ += elapsed_s;
   ++frames_;
 
-  nadir::vo_estimate_t estimate{};
+  msg::VoEstimate estimate;
   estimate.utime = image.utime;
-  estimate.source = "vo_feature";
-  estimate.status = out.status == VoStatus::kTracking ? nadir::vo_estimate_t::STATUS_TRACKING
-                    : out.status == VoStatus::kLost   ? nadir::vo_estimate_t::STATUS_LOST
-                                                      : nadir::vo_estimate_t::STATUS_INITIALIZING;
-  estimate.pose.utime = image.utime;
-  const Eigen::Vector3d p = out.T_world_body.translation();
-  for (int i = 0; i < 3; ++i) estimate.pose.pos[i] = p[i];
-  core::quaternionToWire(Eigen::Quaterniond(out.T_world_body.rotation()),
-                         estimate.pose.orientation);
+  estimate.source = kFeatureSourceName;
+  estimate.status = out.status == VoStatus::kTracking ? msg::VoStatus::TRACKING
+                    : out.status == VoStatus::kLost   ? msg::VoStatus::LOST
+                                                      : msg::VoStatus::INITIALIZING;
+  estimate.p_ned_m = out.T_world_body.translation();
+  estimate.q_world_body = Eigen::Quaterniond(out.T_world_body.rotation());
   estimate.num_features = out.tracked_points;
   estimate.num_resets = out.resets;
   estimate.processing_time_s = params_.wall_clock_timing ? elapsed_s : 0.0;
-  core::publish(bus_, params_.pose_channel, estimate);
+  msg::publish(bus_, params_.pose_channel, estimate);
   if (params_.debug_every_frames > 0 &&
       (frames_ - 1) % static_cast<std::uint64_t>(params_.debug_every_frames) == 0)
     publishDebugImage(gray, image.utime, out);
@@ -147,11 +135,9 @@ void VoFeatureNode::publishDebugImage(const cv::Mat& frame, std::int64_t utime,
   text << status << "  " << out.tracked_points << " matched of " << features.size()
        << " features  map " << vo_.numMapPoints() << " points  key-frames "
        << vo_.timing().keyframes << "  resets " << out.resets;
-  render::RenderedImage rendered;
-  rendered.utime = utime;
-  rendered.image = drawDebugImage(frame, features, text.str());
-  core::publish(bus_, params_.debug_channel,
-                camera::toImageMessage(rendered, params_.debug_jpeg_quality));
+  msg::publish(
+      bus_, params_.debug_channel,
+      msg::Image{utime, drawDebugImage(frame, features, text.str()), params_.debug_jpeg_quality});
 }
 
 }  // namespace nadir::vo

@@ -15,13 +15,15 @@
 
 #include "core/bus.h"
 #include "core/params.h"
-#include "nadir/camera_info_t.hpp"
-#include "nadir/image_t.hpp"
-#include "nadir/pose_t.hpp"
+#include "lcmtypes/image.h"
+#include "lcmtypes/messages.h"
 #include "nodes/common/flight_inputs.h"
 #include "nodes/vo_feature/feature_vo.h"
 
 namespace nadir::vo {
+
+// The node's name: its scenario group, its source name in vo_estimate_t and the metrics.
+inline constexpr char kFeatureSourceName[] = "vo_feature";
 
 struct VoFeatureNodeParams {
   // In a scenario: run the feature VO (nadir run composes it, nadir launch starts
@@ -62,14 +64,14 @@ class VoFeatureNode {
   const FeatureVo& vo() const { return vo_; }
 
  private:
-  void onImage(const nadir::image_t& image);
+  void onImage(const msg::Image& image);
   void drop(const std::string& reason);
   void publishDebugImage(const cv::Mat& frame, std::int64_t utime, const VoFrameOutput& out);
 
   core::Bus& bus_;
   VoFeatureNodeParams params_;
   FeatureVo vo_;
-  std::optional<nadir::camera_info_t> info_;
+  std::optional<msg::CameraInfo> info_;
   nodes::FlightInputs inputs_;
   bool started_ = false;
   std::uint64_t frames_ = 0;

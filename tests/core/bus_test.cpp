@@ -13,8 +13,7 @@
 
 #include "core/bus.h"
 #include "core/log_bus.h"
-#include "nadir/imu_t.hpp"
-#include "nadir/pose_t.hpp"
+#include "lcmtypes/bus_io.h"
 
 namespace nadir::core {
 namespace {
@@ -23,22 +22,22 @@ using std::chrono::milliseconds;
 
 std::string tempPath(const std::string& name) { return ::testing::TempDir() + "nadir_" + name; }
 
-nadir::pose_t makePose(std::int64_t utime, double x) {
-  nadir::pose_t pose{};
+using msg::publish;
+using msg::subscribe;
+
+msg::Pose makePose(std::int64_t utime, double x) {
+  msg::Pose pose;
   pose.utime = utime;
-  pose.pos[0] = x;
-  pose.pos[1] = -2.5;
-  pose.pos[2] = -100.0;
-  pose.orientation[0] = 1.0;
-  pose.vel[2] = 0.125;
+  pose.p_ned_m = Eigen::Vector3d(x, -2.5, -100.0);
+  pose.v_ned_mps.z() = 0.125;
   return pose;
 }
 
-nadir::imu_t makeImu(std::int64_t utime) {
-  nadir::imu_t imu{};
+msg::Imu makeImu(std::int64_t utime) {
+  msg::Imu imu;
   imu.utime = utime;
-  imu.angular_velocity_rps[2] = 0.01;
-  imu.linear_acceleration_mps2[2] = -9.81;
+  imu.angular_velocity_rps.z() = 0.01;
+  imu.linear_acceleration_mps2.z() = -9.81;
   return imu;
 }
 
@@ -46,21 +45,21 @@ nadir::imu_t makeImu(std::int64_t utime) {
 TEST(Bus, MemqRoundTrip) {
   auto bus = openBus("memq://");
   EXPECT_EQ(bus->url(), "memq://");
-  std::vector<nadir::pose_t> received;
-  auto subscription = subscribe<nadir::pose_t>(
-      *bus, "POSE_TRUTH", [&](const nadir::pose_t& pose) { received.push_back(pose); });
+  std::vector<msg::Pose> received;
+  auto subscription = subscribe<msg::Pose>(
+      *bus, "POSE_TRUTH", [&](const msg::Pose& pose) { received.push_back(pose); });
   publish(*bus, "POSE_TRUTH", makePose(1000, 1.5));
   publish(*bus, "POSE_TRUTH", makePose(2000, 2.5));
   EXPECT_EQ(bus->handleAvailable(), 2);
   ASSERT_EQ(received.size(), 2u);
   EXPECT_EQ(received[0].utime, 1000);
-  EXPECT_EQ(received[0].pos[0], 1.5);
+  EXPECT_EQ(received[0].p_ned_m.x(), 1.5);
   EXPECT_EQ(received[1].utime, 2000);
-  EXPECT_EQ(received[1].pos[0], 2.5);
-  EXPECT_EQ(received[1].pos[1], -2.5);
-  EXPECT_EQ(received[1].pos[2], -100.0);
-  EXPECT_EQ(received[1].vel[2], 0.125);
-  EXPECT_EQ(received[1].orientation[0], 1.0);
+  EXPECT_EQ(received[1].p_ned_m.x(), 2.5);
+  EXPECT_EQ(received[1].p_ned_m.y(), -2.5);
+  EXPECT_EQ(received[1].p_ned_m.z(), -100.0);
+  EXPECT_EQ(received[1].v_ned_mps.z(), 0.125);
+  EXPECT_EQ(received[1].q_world_body.w(), 1.0);
   EXPECT_FALSE(bus->handle(milliseconds(0)));
 }
 
@@ -84,11 +83,10 @@ TEST(Bus, ChannelRegexMatchesWholeNames) {
 TEST(Bus, UndecodableMessageIsDroppedAndCounted) {
   auto bus = openBus("memq://");
   int calls = 0;
-  auto subscription =
-      subscribe<nadir::pose_t>(*bus, "POSE_TRUTH", [&](const nadir::pose_t&) { ++calls; });
+  auto subscription = subscribe<msg::Pose>(*bus, "POSE_TRUTH", [&](const msg::Pose&) { ++calls; });
   const std::vector<std::uint8_t> garbage = {1, 2, 3, 4, 5};
   bus->publish("POSE_TRUTH", garbage.data(), garbage.size(), 0);
-  const std::vector<std::uint8_t> imu = encodeMessage(makeImu(5));
+  const msg::Bytes imu = msg::encode(makeImu(5));
   bus->publish("POSE_TRUTH", imu.data(), imu.size(), 5);  // right size class, wrong type
   publish(*bus, "POSE_TRUTH", makePose(7, 0));
   bus->handleAvailable();
@@ -140,7 +138,7 @@ TEST(Bus, SubscriptionLifetime) {
 
 // peekUtime reads a nadir message's utime without decoding it.
 TEST(Bus, PeekUtimeReadsTheFirstField) {
-  const std::vector<std::uint8_t> bytes = encodeMessage(makeImu(1'234'567'890'123LL));
+  const std::vector<std::uint8_t> bytes = msg::encode(makeImu(1'234'567'890'123LL));
   EXPECT_EQ(peekUtime(RawMessage{"IMU", bytes.data(), bytes.size(), 0}), 1'234'567'890'123LL);
   EXPECT_FALSE(peekUtime(RawMessage{"IMU", bytes.data(), 15, 0}));
 }
@@ -157,14 +155,14 @@ TEST(Bus, LogFileRoundTripInSimTime) {
   }
   LogBus reader({.path = path});
   std::vector<std::int64_t> pose_times, imu_times, clock_at_pose;
-  auto poses = subscribe<nadir::pose_t>(reader, "POSE_TRUTH", [&](const nadir::pose_t& pose) {
+  auto poses = subscribe<msg::Pose>(reader, "POSE_TRUTH", [&](const msg::Pose& pose) {
     pose_times.push_back(pose.utime);
     clock_at_pose.push_back(reader.nowUtime());
-    EXPECT_EQ(pose.pos[0], static_cast<double>(pose_times.size() - 1));
+    EXPECT_EQ(pose.p_ned_m.x(), static_cast<double>(pose_times.size() - 1));
   });
-  auto imus = subscribe<nadir::imu_t>(reader, "IMU", [&](const nadir::imu_t& imu) {
+  auto imus = subscribe<msg::Imu>(reader, "IMU", [&](const msg::Imu& imu) {
     imu_times.push_back(imu.utime);
-    EXPECT_EQ(imu.linear_acceleration_mps2[2], -9.81);
+    EXPECT_EQ(imu.linear_acceleration_mps2.z(), -9.81);
   });
   int dispatched = 0;
   while (reader.handle(milliseconds(0))) ++dispatched;
@@ -254,14 +252,14 @@ TEST(BusNetwork, UdpmRoundTripOnThisHost) {
     GTEST_SKIP() << "no multicast route here (" << error.what() << "); nadir doctor shows the fix";
   }
   const std::string channel = "NADIR_TEST_" + std::to_string(::getpid());
-  std::vector<nadir::pose_t> received;
-  auto subscription = subscribe<nadir::pose_t>(
-      *receiver, channel, [&](const nadir::pose_t& pose) { received.push_back(pose); });
+  std::vector<msg::Pose> received;
+  auto subscription = subscribe<msg::Pose>(
+      *receiver, channel, [&](const msg::Pose& pose) { received.push_back(pose); });
   publish(*sender, channel, makePose(42, 3.25));
   for (int i = 0; i < 50 && received.empty(); ++i) receiver->handle(milliseconds(100));
   ASSERT_EQ(received.size(), 1u);
   EXPECT_EQ(received[0].utime, 42);
-  EXPECT_EQ(received[0].pos[0], 3.25);
+  EXPECT_EQ(received[0].p_ned_m.x(), 3.25);
 
   auto thrower = receiver->subscribe(channel + "_THROW", [](const RawMessage&) {
     throw std::runtime_error("from a udpm handler");

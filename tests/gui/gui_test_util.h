@@ -22,6 +22,7 @@
 #include "logs/eval/trajectory.h"
 #include "nadir/pose_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
+#include "tests/support/lcm_messages.h"
 
 namespace nadir::gui::test {
 
@@ -46,16 +47,16 @@ inline Eigen::Vector3d truthPosition(double t_s) {
 inline double truthStamp(int k) { return kT0 + 0.1 * k; }
 inline double estimateStamp(int j) { return kT0 + 0.5 + 0.5 * j; }
 
-inline eval::PoseTrajectory truthTrajectory() {
-  eval::PoseTrajectory truth;
+inline core::Trajectory truthTrajectory() {
+  core::Trajectory truth;
   for (int k = 0; k < kTruthPoses; ++k) {
     truth.push_back({truthStamp(k), truthPosition(truthStamp(k)), attitude()});
   }
   return truth;
 }
 
-inline eval::PoseTrajectory estimateTrajectory() {
-  eval::PoseTrajectory estimates;
+inline core::Trajectory estimateTrajectory() {
+  core::Trajectory estimates;
   for (int j = 0; j < kEstimates; ++j) {
     const double t = estimateStamp(j);
     estimates.push_back({t, truthPosition(t) + kOffset, attitude()});
@@ -80,8 +81,8 @@ inline std::filesystem::path freshDir(const std::string& name) {
 // truth.tum and vo_test.tum, no log, no metrics.json.
 inline std::filesystem::path writeTumRun(const std::string& name) {
   const std::filesystem::path dir = freshDir(name);
-  eval::writeTum((dir / "truth.tum").string(), truthTrajectory());
-  eval::writeTum((dir / "vo_test.tum").string(), estimateTrajectory());
+  core::writeTum((dir / "truth.tum").string(), truthTrajectory());
+  core::writeTum((dir / "vo_test.tum").string(), estimateTrajectory());
   return dir;
 }
 
@@ -96,7 +97,7 @@ inline nadir::pose_t poseMessage(double t_s, const Eigen::Vector3d& p,
 
 template <class Msg>
 void writeMessage(core::LcmLogWriter& writer, const std::string& channel, const Msg& msg) {
-  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
+  const std::vector<std::uint8_t> bytes = ::nadir::test::encodeMessage(msg);
   writer.write(msg.utime, channel, bytes.data(), bytes.size());
 }
 
@@ -106,17 +107,17 @@ inline constexpr int kLostEstimate = 4;
 inline std::filesystem::path writeLogRun(const std::string& name) {
   const std::filesystem::path dir = freshDir(name);
   core::LcmLogWriter writer((dir / "run.lcmlog").string());
-  for (const eval::StampedPose& pose : truthTrajectory()) {
-    writeMessage(writer, "POSE_TRUTH", poseMessage(pose.t_s, pose.p_m, pose.q));
+  for (const core::StampedPose& pose : truthTrajectory()) {
+    writeMessage(writer, "POSE_TRUTH", poseMessage(pose.t_s, pose.p_ned_m, pose.q_world_body));
   }
-  const eval::PoseTrajectory estimates = estimateTrajectory();
+  const core::Trajectory estimates = estimateTrajectory();
   for (int j = 0; j < kEstimates; ++j) {
-    const eval::StampedPose& pose = estimates[static_cast<std::size_t>(j)];
+    const core::StampedPose& pose = estimates[static_cast<std::size_t>(j)];
     nadir::vo_estimate_t msg{};
-    msg.utime = poseMessage(pose.t_s, pose.p_m, pose.q).utime;
+    msg.utime = poseMessage(pose.t_s, pose.p_ned_m, pose.q_world_body).utime;
     msg.source = "vo_feature";
-    msg.status = j == kLostEstimate ? eval::SourceEstimate::kLost : eval::SourceEstimate::kTracking;
-    msg.pose = poseMessage(pose.t_s, pose.p_m, pose.q);
+    msg.status = j == kLostEstimate ? logs::SourceEstimate::kLost : logs::SourceEstimate::kTracking;
+    msg.pose = poseMessage(pose.t_s, pose.p_ned_m, pose.q_world_body);
     writeMessage(writer, "POSE_VO_FEATURE", msg);
   }
   return dir;

@@ -21,6 +21,7 @@
 #include "nadir/image_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
+#include "tests/support/lcm_messages.h"
 
 namespace nadir::gui {
 namespace {
@@ -34,6 +35,7 @@ nadir::pose_t truthMessage(double t_s) {
 nadir::vo_estimate_t estimateMessage(double t_s, int status) {
   nadir::vo_estimate_t m{};
   m.utime = utimeOf(t_s);
+  m.source = "vo_feature";  // estimates are named by their source
   m.status = static_cast<std::int8_t>(status);
   m.pose = truthMessage(t_s);
   for (int i = 0; i < 3; ++i) m.pose.pos[i] += test::kOffset[i];
@@ -63,13 +65,14 @@ TEST(GuiLiveFeed, GathersTheRunAsItComes) {
   int j = 0;
   for (int k = 0; k < test::kTruthPoses; ++k) {
     const double t = test::truthStamp(k);
-    core::publish(*bus, "POSE_TRUTH", truthMessage(t));
+    ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(t));
     if (j < test::kEstimates && test::estimateStamp(j) <= t + 1e-9) {
-      core::publish(*bus, "POSE_VO_FEATURE",
-                    estimateMessage(test::estimateStamp(j), nadir::vo_estimate_t::STATUS_TRACKING));
+      ::nadir::test::publish(
+          *bus, "POSE_VO_FEATURE",
+          estimateMessage(test::estimateStamp(j), nadir::vo_estimate_t::STATUS_TRACKING));
       ++j;
     }
-    if (k % 10 == 0) core::publish(*bus, "CAMERA_DOWN", imageMessage(t, 8, 6, k));
+    if (k % 10 == 0) ::nadir::test::publish(*bus, "CAMERA_DOWN", imageMessage(t, 8, 6, k));
   }
   while (feed.poll() > 0) {
   }
@@ -80,7 +83,7 @@ TEST(GuiLiveFeed, GathersTheRunAsItComes) {
   EXPECT_DOUBLE_EQ(run->t0_s, test::kT0);
   ASSERT_EQ(run->sources.count("vo_feature"), 1u);
   const SourceSeries& source = run->sources.at("vo_feature");
-  ASSERT_EQ(source.pose.size(), static_cast<std::size_t>(test::kEstimates));
+  ASSERT_EQ(source.size(), static_cast<std::size_t>(test::kEstimates));
   for (double error : source.position_error_m) EXPECT_NEAR(error, 5.0, 1e-6);
   EXPECT_TRUE(run->damage.empty()) << run->damage;
 
@@ -98,25 +101,31 @@ TEST(GuiLiveFeed, GathersTheRunAsItComes) {
 }
 
 // A message that does not decode is counted in the run's damage, and the rest of
-// the run is kept; a channel the feed does not know changes nothing.
+// the run is kept; a pose_t on another channel than the truth's named one
+// changes nothing.
 TEST(GuiLiveFeed, CountsDamagedMessagesAndIgnoresOthers) {
   const std::unique_ptr<core::Bus> bus = core::openBus("memq://");
-  LiveFeed feed(*bus);
-  core::publish(*bus, "POSE_TRUTH", truthMessage(100.0));
+  LiveFeedParams params;
+  params.truth_channel = "POSE_TRUTH";
+  LiveFeed feed(*bus, params);
+  ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(100.0));
   const std::uint8_t junk[5] = {1, 2, 3, 4, 5};
   bus->publish("POSE_TRUTH", junk, sizeof junk, 0);
-  bus->publish("POSE_VO_DIRECT", junk, sizeof junk, 0);
+  // An estimate cut short: its type is known, its body is not whole.
+  std::vector<std::uint8_t> cut = ::nadir::test::encodeMessage(estimateMessage(100.0, 1));
+  cut.resize(cut.size() - 3);
+  bus->publish("POSE_VO_DIRECT", cut.data(), cut.size(), 0);
   nadir::pose_t not_a_rotation = truthMessage(100.1);
   not_a_rotation.orientation[0] = 0.0;
   not_a_rotation.orientation[1] = 0.0;
   not_a_rotation.orientation[2] = 0.0;
   not_a_rotation.orientation[3] = 0.0;
-  core::publish(*bus, "POSE_TRUTH", not_a_rotation);
-  core::publish(*bus, "POSE_TRUTH", truthMessage(100.2));
+  ::nadir::test::publish(*bus, "POSE_TRUTH", not_a_rotation);
+  ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(100.2));
   while (feed.poll() > 0) {
   }
   const std::uint64_t version = feed.version();
-  core::publish(*bus, "SOMETHING_ELSE", truthMessage(100.3));
+  ::nadir::test::publish(*bus, "SOMETHING_ELSE", truthMessage(100.3));
   while (feed.poll() > 0) {
   }
   EXPECT_EQ(feed.version(), version);
@@ -136,7 +145,7 @@ TEST(GuiLiveFeed, KeepsTheNewestImagesWithinTheBudget) {
   RecentCameraFrames frames("CAMERA_DOWN", 3 * 100);  // three 10x10 gray images
   for (int i = 0; i < 5; ++i) {
     const std::vector<std::uint8_t> bytes =
-        core::encodeMessage(imageMessage(10.0 + i, 10, 10, static_cast<std::uint8_t>(i)));
+        ::nadir::test::encodeMessage(imageMessage(10.0 + i, 10, 10, static_cast<std::uint8_t>(i)));
     frames.add(bytes.data(), bytes.size());
   }
   EXPECT_EQ(frames.count(), 3u);
@@ -145,7 +154,7 @@ TEST(GuiLiveFeed, KeepsTheNewestImagesWithinTheBudget) {
   EXPECT_EQ(frames.frameAt(12.0)->number, 2);
   nadir::image_t wrong = imageMessage(15.0, 10, 10, 0);
   wrong.pixelformat = 12345;
-  const std::vector<std::uint8_t> bytes = core::encodeMessage(wrong);
+  const std::vector<std::uint8_t> bytes = ::nadir::test::encodeMessage(wrong);
   frames.add(bytes.data(), bytes.size());
   const std::optional<CameraFrame> last = frames.frameAt(20.0);
   ASSERT_TRUE(last);
@@ -162,7 +171,7 @@ TEST(GuiLogCameraFrames, FindsTheImageOfATime) {
   {
     core::LcmLogWriter writer(log_path);
     const auto write = [&writer](const std::string& channel, const auto& message) {
-      const std::vector<std::uint8_t> bytes = core::encodeMessage(message);
+      const std::vector<std::uint8_t> bytes = ::nadir::test::encodeMessage(message);
       writer.write(message.utime, channel, bytes.data(), bytes.size());
     };
     write("POSE_TRUTH", truthMessage(100.0));

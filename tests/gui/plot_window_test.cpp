@@ -37,6 +37,7 @@
 #include "gui/live_feed.h"
 #include "gui/plots.h"
 #include "gui_test_util.h"
+#include "tests/support/lcm_messages.h"
 
 namespace nadir::gui {
 namespace {
@@ -409,21 +410,23 @@ TEST_F(GuiPlotWindow, LiveRunIsPlottedAsItComes) {
   EXPECT_EQ(window.run(), nullptr);  // nothing on the bus yet
   EXPECT_TRUE(window.lastError().contains(QStringLiteral("waiting for the truth")));
 
-  const eval::PoseTrajectory truth = test::truthTrajectory();
-  const eval::PoseTrajectory estimates = test::estimateTrajectory();
+  const core::Trajectory truth = test::truthTrajectory();
+  const core::Trajectory estimates = test::estimateTrajectory();
   double published_s = 0.0;
   const auto publish = [&](double until_s) {
-    for (const eval::StampedPose& pose : truth) {
+    for (const core::StampedPose& pose : truth) {
       if (pose.t_s > until_s || pose.t_s <= published_s) continue;
-      core::publish(*bus, "POSE_TRUTH", test::poseMessage(pose.t_s, pose.p_m, pose.q));
+      ::nadir::test::publish(*bus, "POSE_TRUTH",
+                             test::poseMessage(pose.t_s, pose.p_ned_m, pose.q_world_body));
     }
-    for (const eval::StampedPose& pose : estimates) {
+    for (const core::StampedPose& pose : estimates) {
       if (pose.t_s > until_s || pose.t_s <= published_s) continue;
       nadir::vo_estimate_t message{};
-      message.pose = test::poseMessage(pose.t_s, pose.p_m, pose.q);
+      message.pose = test::poseMessage(pose.t_s, pose.p_ned_m, pose.q_world_body);
       message.utime = message.pose.utime;
+      message.source = "vo_feature";
       message.status = nadir::vo_estimate_t::STATUS_TRACKING;
-      core::publish(*bus, "POSE_VO_FEATURE", message);
+      ::nadir::test::publish(*bus, "POSE_VO_FEATURE", message);
     }
     published_s = until_s;
   };

@@ -72,7 +72,7 @@ TEST_F(GuiPlots, HeadlessRenderingWritesNonBlankPngsOfTheRightSize) {
     ASSERT_FALSE(image.isNull()) << name;
     EXPECT_EQ(image.width(), 1200) << name;
     EXPECT_EQ(image.height(), 800) << name;
-    const PixelCounts counts = countPixels(image, QColor(0x94, 0x67, 0xbd));
+    const PixelCounts counts = countPixels(image, sourceColor(run, "vo_test"));
     EXPECT_GT(counts.not_white, 1200 * 800 / 50) << name;  // axes, labels and lines
     EXPECT_GT(counts.near_source, 50) << name;             // the source's line and legend
     if (name != "error") {

@@ -17,7 +17,7 @@ namespace nadir::gui {
 namespace {
 
 namespace fs = std::filesystem;
-using eval::SourceEstimate;
+using logs::SourceEstimate;
 using test::kEstimates;
 using test::kLostEstimate;
 using test::kTruthPoses;
@@ -56,26 +56,30 @@ TEST(GuiRunData, LoadsTumFilesAndComputesMetrics) {
   EXPECT_DOUBLE_EQ(run.t0_s, test::kT0);
 
   ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kTruthPoses));
-  EXPECT_NEAR(run.truth.x_m.back(), 100.0, 1e-9);  // 10 m/s for 10 s
-  EXPECT_NEAR(run.truth.y_m.back(), 50.0, 1e-9);
-  EXPECT_NEAR(run.truth.z_m.back(), -100.0, 1e-9);
-  EXPECT_NEAR(run.truth.roll_deg[7], test::kRollDeg, 1e-9);
-  EXPECT_NEAR(run.truth.pitch_deg[7], test::kPitchDeg, 1e-9);
-  EXPECT_NEAR(run.truth.yaw_deg[7], test::kYawDeg, 1e-9);
+  const FigureColumns truth = figureColumns(run.truth);
+  EXPECT_NEAR(truth.x_m.back(), 100.0, 1e-9);  // 10 m/s for 10 s
+  EXPECT_NEAR(truth.y_m.back(), 50.0, 1e-9);
+  EXPECT_NEAR(truth.z_m.back(), -100.0, 1e-9);
+  EXPECT_NEAR(truth.roll_deg[7], test::kRollDeg, 1e-9);
+  EXPECT_NEAR(truth.pitch_deg[7], test::kPitchDeg, 1e-9);
+  EXPECT_NEAR(truth.yaw_deg[7], test::kYawDeg, 1e-9);
 
   ASSERT_EQ(run.sources.size(), 1u);
   const SourceSeries& source = run.sources.at("vo_test");
-  ASSERT_EQ(source.pose.size(), static_cast<std::size_t>(kEstimates));
+  const FigureColumns pose = figureColumns(source);
+  ASSERT_EQ(pose.size(), static_cast<std::size_t>(kEstimates));
   ASSERT_EQ(source.position_error_m.size(), static_cast<std::size_t>(kEstimates));
   for (int j = 0; j < kEstimates; ++j) {
     const auto i = static_cast<std::size_t>(j);
-    EXPECT_EQ(source.status[i], SourceEstimate::kTracking);
+    EXPECT_EQ(source.estimates[i].status, SourceEstimate::kTracking);
     EXPECT_NEAR(source.position_error_m[i], 5.0, 1e-9) << j;  // |(3, 4, 0)|
-    EXPECT_NEAR(source.pose.yaw_deg[i], test::kYawDeg, 1e-9);
+    EXPECT_NEAR(pose.yaw_deg[i], test::kYawDeg, 1e-9);
   }
   // At t = 100.5 s the truth is at (5, 2.5, -100); the estimate 3 m north, 4 m east.
-  EXPECT_NEAR(source.pose.x_m.front(), 8.0, 1e-9);
-  EXPECT_NEAR(source.pose.y_m.front(), 6.5, 1e-9);
+  EXPECT_NEAR(pose.x_m.front(), 8.0, 1e-9);
+  EXPECT_NEAR(pose.y_m.front(), 6.5, 1e-9);
+  ASSERT_EQ(source.tracked.size(), 1u);
+  EXPECT_EQ(source.tracked.front().size(), static_cast<std::size_t>(kEstimates));
 
   const eval::SourceMetrics& m = run.metrics.sources.at("vo_test");
   EXPECT_NEAR(m.position_rmse_m, 5.0, 1e-9);
@@ -93,19 +97,23 @@ TEST(GuiRunData, LoadsTheLogWithStatuses) {
   EXPECT_TRUE(run.damage.empty()) << run.damage;
   ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kTruthPoses));
   const SourceSeries& source = run.sources.at("vo_feature");
-  ASSERT_EQ(source.status.size(), static_cast<std::size_t>(kEstimates));
+  const FigureColumns pose = figureColumns(source);
+  ASSERT_EQ(source.estimates.size(), static_cast<std::size_t>(kEstimates));
   for (int j = 0; j < kEstimates; ++j) {
     const auto i = static_cast<std::size_t>(j);
     if (j == kLostEstimate) {
-      EXPECT_EQ(source.status[i], SourceEstimate::kLost);
+      EXPECT_EQ(source.estimates[i].status, SourceEstimate::kLost);
       EXPECT_TRUE(std::isnan(source.position_error_m[i]));
-      EXPECT_TRUE(std::isnan(source.pose.x_m[i]));
-      EXPECT_TRUE(std::isnan(source.pose.roll_deg[i]));
+      EXPECT_TRUE(std::isnan(pose.x_m[i]));
+      EXPECT_TRUE(std::isnan(pose.roll_deg[i]));
     } else {
-      EXPECT_EQ(source.status[i], SourceEstimate::kTracking);
+      EXPECT_EQ(source.estimates[i].status, SourceEstimate::kTracking);
       EXPECT_NEAR(source.position_error_m[i], 5.0, 1e-6) << j;  // utime rounds to 1 us
     }
   }
+  // The LOST estimate splits the tracking into two stretches.
+  ASSERT_EQ(source.tracked.size(), 2u);
+  EXPECT_EQ(source.tracked[0].size(), static_cast<std::size_t>(kLostEstimate));
   EXPECT_NEAR(run.metrics.sources.at("vo_feature").position_rmse_m, 5.0, 1e-6);
 }
 
@@ -190,7 +198,7 @@ std::string loadError(const fs::path& dir) {
 TEST(GuiRunData, EstimateYawIsDrawnOnTheTruthsSideOfSouth) {
   constexpr double kRad = std::numbers::pi / 180.0;
   const fs::path dir = test::freshDir("south");
-  eval::PoseTrajectory truth, estimate;
+  core::Trajectory truth, estimate;
   for (int k = 0; k < 11; ++k) {
     const double t = 100.0 + 0.1 * k;
     truth.push_back(
@@ -198,12 +206,13 @@ TEST(GuiRunData, EstimateYawIsDrawnOnTheTruthsSideOfSouth) {
     estimate.push_back(
         {t, Eigen::Vector3d(0, 0, -100), core::quaternionFromRpy({0, 0, -179.5 * kRad})});
   }
-  eval::writeTum((dir / "truth.tum").string(), truth);
-  eval::writeTum((dir / "vo_test.tum").string(), estimate);
+  core::writeTum((dir / "truth.tum").string(), truth);
+  core::writeTum((dir / "vo_test.tum").string(), estimate);
   const RunData run = loadRun(dir.string());
   const SourceSeries& vo = run.sources.at("vo_test");
-  ASSERT_EQ(vo.pose.size(), 11u);
-  for (double yaw_deg : vo.pose.yaw_deg) EXPECT_NEAR(yaw_deg, 180.5, 1e-6);
+  const FigureColumns pose = figureColumns(vo);
+  ASSERT_EQ(pose.size(), 11u);
+  for (double yaw_deg : pose.yaw_deg) EXPECT_NEAR(yaw_deg, 180.5, 1e-6);
 }
 
 TEST(GuiRunData, RefusesADamagedTumFileNamingIt) {
@@ -287,10 +296,10 @@ TEST(GuiRunData, ComparesWithAnotherTrajectoryAsTheTruth) {
   EXPECT_EQ(run.truth_name, "vo_test");
   EXPECT_DOUBLE_EQ(run.t0_s, test::estimateStamp(0));
   ASSERT_EQ(run.truth.size(), static_cast<std::size_t>(kEstimates));
-  EXPECT_NEAR(run.truth.x_m.front(), 8.0, 1e-9);  // (5, 2.5) + (3, 4)
+  EXPECT_NEAR(run.truth.front().p_ned_m.x(), 8.0, 1e-9);  // (5, 2.5) + (3, 4)
   ASSERT_EQ(run.sources.size(), 1u);
   const SourceSeries& truth = run.sources.at("truth");
-  ASSERT_EQ(truth.pose.size(), static_cast<std::size_t>(kTruthPoses));
+  ASSERT_EQ(truth.size(), static_cast<std::size_t>(kTruthPoses));
   EXPECT_TRUE(std::isnan(truth.position_error_m.front()));  // t = 100 s: before vo_test
   EXPECT_NEAR(truth.position_error_m[5], 5.0, 1e-9);        // t = 100.5 s
   EXPECT_NEAR(truth.position_error_m[50], 5.0, 1e-9);
@@ -348,8 +357,8 @@ TEST(GuiRunData, RefusesATruthTheRunDoesNotHave) {
 // either way the run says it guessed.
 TEST(GuiRunData, GuessesTheTruthOfTumFilesWithoutTruthTum) {
   const fs::path named = test::freshDir("groundtruth");
-  eval::writeTum((named / "estimate.tum").string(), test::estimateTrajectory());
-  eval::writeTum((named / "groundtruth.tum").string(), test::truthTrajectory());
+  core::writeTum((named / "estimate.tum").string(), test::estimateTrajectory());
+  core::writeTum((named / "groundtruth.tum").string(), test::truthTrajectory());
   ASSERT_TRUE(isRunDir(named.string()));
   const RunData run = loadRun(named.string());
   EXPECT_EQ(run.truth_name, "groundtruth");
@@ -359,8 +368,8 @@ TEST(GuiRunData, GuessesTheTruthOfTumFilesWithoutTruthTum) {
   EXPECT_NEAR(run.metrics.sources.at("estimate").position_rmse_m, 5.0, 1e-9);
 
   const fs::path unnamed = test::freshDir("unnamed");
-  eval::writeTum((unnamed / "b.tum").string(), test::truthTrajectory());
-  eval::writeTum((unnamed / "a.tum").string(), test::estimateTrajectory());
+  core::writeTum((unnamed / "b.tum").string(), test::truthTrajectory());
+  core::writeTum((unnamed / "a.tum").string(), test::estimateTrajectory());
   const RunData first = loadRun(unnamed.string());
   EXPECT_EQ(first.truth_name, "a");
   EXPECT_NE(first.truth_note.find("the first by name"), std::string::npos) << first.truth_note;

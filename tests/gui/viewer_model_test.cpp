@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 #include <numbers>
 
 #include "core/frames.h"
@@ -14,15 +13,16 @@
 namespace nadir::gui {
 namespace {
 
-PoseSeries line(const std::vector<double>& stamps) {
-  PoseSeries s;
-  for (double t : stamps) {
-    const Eigen::Vector3d p = test::truthPosition(t);
-    s.t_s.push_back(t);
-    s.x_m.push_back(p.x());
-    s.y_m.push_back(p.y());
-    s.z_m.push_back(p.z());
-  }
+core::Trajectory line(const std::vector<double>& stamps) {
+  core::Trajectory s;
+  for (double t : stamps) s.push_back({t, test::truthPosition(t), Eigen::Quaterniond::Identity()});
+  return s;
+}
+
+// A source whose TRACKING stretches are these (a LOST estimate between them).
+SourceSeries source(std::vector<core::Trajectory> stretches) {
+  SourceSeries s;
+  s.tracked = std::move(stretches);
   return s;
 }
 
@@ -39,16 +39,16 @@ TEST(GuiViewerModel, PositionIsTheTruthInterpolated) {
 }
 
 TEST(GuiViewerModel, NoPositionAcrossAGapOrAMissingPose) {
-  PoseSeries s = line({0.0, 0.5, 3.0, 3.5, 4.0});
-  s.x_m[4] = std::numeric_limits<double>::quiet_NaN();
+  // The estimate at 4.0 s is LOST.
+  const SourceSeries s = source({line({0.0, 0.5, 3.0, 3.5})});
   EXPECT_TRUE(positionAt(s, 0.25));
   EXPECT_FALSE(positionAt(s, 2.0));
   EXPECT_FALSE(positionAt(s, 3.75));
 }
 
 TEST(GuiViewerModel, TrackGrowsToTheTimeAndBreaksAtGaps) {
-  PoseSeries s = line({0.0, 0.5, 1.0, 3.0, 3.5, 4.0, 4.5});
-  s.y_m[5] = std::numeric_limits<double>::quiet_NaN();
+  // Samples at 0, 0.5, 1, 3, 3.5, 4 (LOST) and 4.5 s.
+  const SourceSeries s = source({line({0.0, 0.5, 1.0, 3.0, 3.5}), line({4.5})});
   const auto lines = trackUpTo(s, 3.25);
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0].size(), 3u);
@@ -87,13 +87,14 @@ TEST(GuiViewerModel, OrbitCameraLooksAtItsTarget) {
 // The attitude halfway between yaw 170 deg and -170 deg is yaw 180 deg (the short
 // way round, not 0), at roll 10 deg throughout; none outside the span or across a gap.
 TEST(GuiViewerModel, AttitudeIsInterpolatedTheShortWayRound) {
-  PoseSeries s = line({0.0, 1.0, 5.0});
-  s.roll_deg = {10.0, 10.0, 10.0};
-  s.pitch_deg = {0.0, 0.0, 0.0};
-  s.yaw_deg = {170.0, -170.0, -170.0};
+  constexpr double kRad = std::numbers::pi / 180.0;
+  core::Trajectory s = line({0.0, 1.0, 5.0});
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s[i].q_world_body =
+        core::quaternionFromRpy({10.0 * kRad, 0.0, (i == 0 ? 170.0 : -170.0) * kRad});
+  }
   const auto q = attitudeAt(s, 0.5);
   ASSERT_TRUE(q);
-  constexpr double kRad = std::numbers::pi / 180.0;
   const Eigen::Quaterniond expected = core::quaternionFromRpy({10.0 * kRad, 0.0, 180.0 * kRad});
   EXPECT_LT(q->angularDistance(expected), 1e-9);
   EXPECT_FALSE(attitudeAt(s, -0.1));

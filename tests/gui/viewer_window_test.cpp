@@ -34,6 +34,7 @@
 #include "gui_test_util.h"
 #include "nadir/image_t.hpp"
 #include "nadir/pose_t.hpp"
+#include "tests/support/lcm_messages.h"
 
 namespace nadir::gui {
 namespace {
@@ -75,17 +76,15 @@ class GuiViewerWindow : public ::testing::Test {
 
 // The truth at t (s since its start), interpolated here without the viewer's code.
 Eigen::Vector3d truthAt(const RunData& run, double t) {
-  const PoseSeries& s = run.truth;
+  const core::Trajectory& s = run.truth;
   const double stamp = run.t0_s + t;
   for (std::size_t i = 1; i < s.size(); ++i) {
-    if (s.t_s[i] >= stamp) {
-      const double a = (stamp - s.t_s[i - 1]) / (s.t_s[i] - s.t_s[i - 1]);
-      return Eigen::Vector3d(s.x_m[i - 1] + a * (s.x_m[i] - s.x_m[i - 1]),
-                             s.y_m[i - 1] + a * (s.y_m[i] - s.y_m[i - 1]),
-                             s.z_m[i - 1] + a * (s.z_m[i] - s.z_m[i - 1]));
+    if (s[i].t_s >= stamp) {
+      const double a = (stamp - s[i - 1].t_s) / (s[i].t_s - s[i - 1].t_s);
+      return s[i - 1].p_ned_m + a * (s[i].p_ned_m - s[i - 1].p_ned_m);
     }
   }
-  return Eigen::Vector3d(s.x_m.back(), s.y_m.back(), s.z_m.back());
+  return s.back().p_ned_m;
 }
 
 bool isRed(QRgb c) { return qRed(c) > 200 && qGreen(c) < 60 && qBlue(c) < 60; }
@@ -107,7 +106,7 @@ bool near(const QImage& image, const Eigen::Vector2d& uv, int radius, Match matc
 TEST_F(GuiViewerWindow, SeekShowsTheTimeAndTheVehicleAtTheTruth) {
   const auto window = open({runDir()});
   const RunData& run = window->runs().front();
-  EXPECT_NEAR(window->duration(), run.truth.t_s.back() - run.t0_s, 1e-9);
+  EXPECT_NEAR(window->duration(), run.truth.back().t_s - run.t0_s, 1e-9);
   for (double t : {0.0, 1.2345, 4.321, 7.77}) {
     window->seek(t);
     EXPECT_DOUBLE_EQ(window->time(), t);
@@ -260,7 +259,7 @@ TEST_F(GuiViewerWindow, SeveralRunsPlayTogether) {
   const auto window = open({runDir(), tum.string(), runDir()});
   ASSERT_EQ(window->runs().size(), 3u);
   const double expected =
-      std::max(window->runs()[0].truth.t_s.back() - window->runs()[0].t0_s, 10.0);
+      std::max(window->runs()[0].truth.back().t_s - window->runs()[0].t0_s, 10.0);
   EXPECT_DOUBLE_EQ(window->duration(), expected);
 
   window->setSpeed(100.0);
@@ -313,7 +312,7 @@ TEST_F(GuiViewerWindow, CameraPanelShowsTheLogImageOfTheTime) {
     while (const auto event = reader.next()) {
       if (event->channel != "CAMERA_DOWN") continue;
       nadir::image_t message;
-      ASSERT_TRUE(core::decodeMessage(event->data.data(), event->data.size(), message));
+      ASSERT_TRUE(::nadir::test::decodeMessage(event->data.data(), event->data.size(), message));
       if (static_cast<double>(message.utime) / 1e6 <= run.t0_s + t) {
         expected = message;
         found = true;
@@ -376,7 +375,7 @@ TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
       const Eigen::Vector3d p = test::truthPosition(t);
       for (int i = 0; i < 3; ++i) pose.pos[i] = p[i];
       pose.orientation[0] = 1.0;
-      core::publish(*bus, "POSE_TRUTH", pose);
+      ::nadir::test::publish(*bus, "POSE_TRUTH", pose);
       if (k % 5 == 0) {
         nadir::image_t image{};
         image.utime = pose.utime;
@@ -386,7 +385,7 @@ TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
         image.pixelformat = nadir::image_t::PIXEL_FORMAT_GRAY;
         image.data.assign(16 * 12, static_cast<std::uint8_t>(k));
         image.size = 16 * 12;
-        core::publish(*bus, "CAMERA_DOWN", image);
+        ::nadir::test::publish(*bus, "CAMERA_DOWN", image);
       }
     }
   };

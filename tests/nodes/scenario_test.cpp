@@ -13,11 +13,10 @@
 
 #include "core/bus.h"
 #include "core/frames.h"
-#include "nadir/pose_t.hpp"
-#include "nodes/sim/sim_messages.h"
+#include "lcmtypes/bus_io.h"
+#include "nodes/scenario.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
-#include "nodes/scenario.h"
 #include "terrain/world_factory.h"
 
 namespace nadir::scenario {
@@ -382,9 +381,8 @@ TEST(Scenario, FlightCsvRoundTripsThroughTheTruthStream) {
 
   auto bus = core::openBus("memq://");
   std::vector<sim::VehicleState> received;
-  auto subscription = core::subscribe<nadir::pose_t>(
-      *bus, "POSE_TRUTH",
-      [&](const nadir::pose_t& pose) { received.push_back(sim::stateFromPoseMessage(pose)); });
+  auto subscription = msg::subscribe<msg::Pose>(
+      *bus, "POSE_TRUTH", [&](const msg::Pose& pose) { received.push_back(pose); });
   const terrain::BuiltWorld built = terrain::makeWorld(scenario.world);
   sim::Simulator simulator(scenario.sim, built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));

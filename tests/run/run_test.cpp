@@ -15,10 +15,10 @@
 #include "core/bus.h"
 #include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
+#include "nodes/scenario.h"
 #include "run/launch.h"
 #include "run/run.h"
 #include "run/sweep.h"
-#include "nodes/scenario.h"
 
 namespace nadir::run {
 namespace {
@@ -125,7 +125,7 @@ TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
     }
   }
   EXPECT_EQ(readFile(replayed), readFile(result.log_path));
-  const eval::LogTrajectories recorded = eval::readRunLog(replayed);
+  const logs::LogTrajectories recorded = logs::readRunLog(replayed);
   const eval::EvalOptions options;
   const eval::RunMetrics metrics = eval::evaluate(recorded.truth, recorded.sources, options);
   const std::string json = (fs::path(result.out_dir) / "replayed.json").string();

@@ -20,22 +20,22 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Five non-coplanar positions with varied attitudes.
-PoseTrajectory reference() {
+core::Trajectory reference() {
   const double xyz[5][3] = {{0, 0, 0}, {10, 0, 0}, {10, 5, 0}, {0, 5, 2}, {3, 1, -1}};
   const double yaw_deg[5] = {0, 30, 60, -45, 170};
-  PoseTrajectory ref;
+  core::Trajectory ref;
   for (int i = 0; i < 5; ++i) {
-    StampedPose pose;
+    core::StampedPose pose;
     pose.t_s = i;
-    pose.p_m = Eigen::Vector3d(xyz[i][0], xyz[i][1], xyz[i][2]);
-    pose.q = Eigen::AngleAxisd(yaw_deg[i] * kDeg, Eigen::Vector3d::UnitZ()) *
-             Eigen::AngleAxisd(5.0 * i * kDeg, Eigen::Vector3d::UnitX());
+    pose.p_ned_m = Eigen::Vector3d(xyz[i][0], xyz[i][1], xyz[i][2]);
+    pose.q_world_body = Eigen::AngleAxisd(yaw_deg[i] * kDeg, Eigen::Vector3d::UnitZ()) *
+                        Eigen::AngleAxisd(5.0 * i * kDeg, Eigen::Vector3d::UnitX());
     ref.push_back(pose);
   }
   return ref;
 }
 
-Statistics apeAfter(const PoseTrajectory& ref, PoseTrajectory est, AlignMode mode,
+Statistics apeAfter(const core::Trajectory& ref, core::Trajectory est, AlignMode mode,
                     Alignment* used = nullptr) {
   const Alignment alignment = alignTrajectories(ref, est, mode);
   applyAlignment(alignment, est);
@@ -45,9 +45,9 @@ Statistics apeAfter(const PoseTrajectory& ref, PoseTrajectory est, AlignMode mod
 
 // Estimate = truth + (1, 2, 3): no alignment reports the offset, SE(3) and Sim(3) remove it.
 TEST(EvalAlignment, PureOffset) {
-  const PoseTrajectory ref = reference();
-  PoseTrajectory est = ref;
-  for (StampedPose& pose : est) pose.p_m += Eigen::Vector3d(1, 2, 3);
+  const core::Trajectory ref = reference();
+  core::Trajectory est = ref;
+  for (core::StampedPose& pose : est) pose.p_ned_m += Eigen::Vector3d(1, 2, 3);
   EXPECT_NEAR(apeAfter(ref, est, AlignMode::kNone).rmse, std::sqrt(14.0), 1e-12);
   EXPECT_NEAR(apeAfter(ref, est, AlignMode::kNone).std, 0.0, 1e-12);
   Alignment se3;
@@ -60,12 +60,12 @@ TEST(EvalAlignment, PureOffset) {
 
 // Estimate = the truth rotated 30 deg about z through the origin: SE(3) finds the inverse rotation.
 TEST(EvalAlignment, PureRotationAboutOrigin) {
-  const PoseTrajectory ref = reference();
+  const core::Trajectory ref = reference();
   const Eigen::Quaterniond rotation(Eigen::AngleAxisd(30 * kDeg, Eigen::Vector3d::UnitZ()));
-  PoseTrajectory est = ref;
-  for (StampedPose& pose : est) {
-    pose.p_m = rotation * pose.p_m;
-    pose.q = rotation * pose.q;
+  core::Trajectory est = ref;
+  for (core::StampedPose& pose : est) {
+    pose.p_ned_m = rotation * pose.p_ned_m;
+    pose.q_world_body = rotation * pose.q_world_body;
   }
   // Unaligned, every attitude is 30 deg off.
   const std::vector<double> raw_rotation = apeRotationErrorsDeg(ref, est);
@@ -75,16 +75,16 @@ TEST(EvalAlignment, PureRotationAboutOrigin) {
   EXPECT_NEAR(apeAfter(ref, est, AlignMode::kSe3, &se3).rmse, 0.0, 1e-9);
   EXPECT_NEAR(Eigen::Quaterniond(se3.R).angularDistance(rotation.conjugate()), 0.0, 1e-9);
   EXPECT_NEAR(se3.t.norm(), 0.0, 1e-9);
-  PoseTrajectory aligned = est;
+  core::Trajectory aligned = est;
   applyAlignment(se3, aligned);
   for (const double e : apeRotationErrorsDeg(ref, aligned)) EXPECT_NEAR(e, 0.0, 1e-6);
 }
 
 // Estimate = truth positions at half scale: only Sim(3) removes it, reporting scale 2.
 TEST(EvalAlignment, ScaleOnlySim3Recovers) {
-  const PoseTrajectory ref = reference();
-  PoseTrajectory est = ref;
-  for (StampedPose& pose : est) pose.p_m *= 0.5;
+  const core::Trajectory ref = reference();
+  core::Trajectory est = ref;
+  for (core::StampedPose& pose : est) pose.p_ned_m *= 0.5;
   EXPECT_GT(apeAfter(ref, est, AlignMode::kNone).rmse, 1.0);
   EXPECT_GT(apeAfter(ref, est, AlignMode::kSe3).rmse, 1.0);
   Alignment sim3;

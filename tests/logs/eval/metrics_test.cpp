@@ -16,18 +16,18 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-StampedPose pose(double t, const Eigen::Vector3d& p, double roll_deg = 0, double pitch_deg = 0,
-                 double yaw_deg = 0) {
-  StampedPose out;
+core::StampedPose pose(double t, const Eigen::Vector3d& p, double roll_deg = 0,
+                       double pitch_deg = 0, double yaw_deg = 0) {
+  core::StampedPose out;
   out.t_s = t;
-  out.p_m = p;
-  out.q = core::quaternionFromRpy({roll_deg * kDeg, pitch_deg * kDeg, yaw_deg * kDeg});
+  out.p_ned_m = p;
+  out.q_world_body = core::quaternionFromRpy({roll_deg * kDeg, pitch_deg * kDeg, yaw_deg * kDeg});
   return out;
 }
 
 // Poses along x at the given positions, identity attitude, 1 s apart.
-PoseTrajectory alongX(const std::vector<double>& xs) {
-  PoseTrajectory out;
+core::Trajectory alongX(const std::vector<double>& xs) {
+  core::Trajectory out;
   for (std::size_t i = 0; i < xs.size(); ++i) {
     out.push_back(pose(static_cast<double>(i), Eigen::Vector3d(xs[i], 0, 0)));
   }
@@ -52,17 +52,17 @@ TEST(EvalStatistics, FixedVector) {
 
 // APE rotation is the angle of P_est^-1 P_ref: a 10 deg yaw error gives 10 deg at any attitude.
 TEST(EvalApe, RotationAngle) {
-  const PoseTrajectory ref = {pose(0, {0, 0, 0}, 20, -10, 100)};
-  const PoseTrajectory est = {
-      StampedPose{0, {0, 0, 0}, Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitZ()) * ref[0].q}};
+  const core::Trajectory ref = {pose(0, {0, 0, 0}, 20, -10, 100)};
+  const core::Trajectory est = {core::StampedPose{
+      0, {0, 0, 0}, Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitZ()) * ref[0].q_world_body}};
   EXPECT_NEAR(apeRotationErrorsDeg(ref, est)[0], 10.0, 1e-9);
   EXPECT_NEAR(apeTranslationErrors(ref, est)[0], 0.0, 1e-15);
 }
 
 // RPE in frames: x truth 0 1 2 3 4, estimate 0 1 2.5 3.5 4.5; delta 1 -> errors 0 .5 0 0.
 TEST(EvalRpe, FramesHandExample) {
-  const PoseTrajectory ref = alongX({0, 1, 2, 3, 4});
-  const PoseTrajectory est = alongX({0, 1, 2.5, 3.5, 4.5});
+  const core::Trajectory ref = alongX({0, 1, 2, 3, 4});
+  const core::Trajectory est = alongX({0, 1, 2.5, 3.5, 4.5});
   const IndexPairs pairs = rpePairs(est, 1, DeltaUnit::kFrames);
   ASSERT_EQ(pairs.size(), 4u);
   const Statistics s = computeStatistics(rpeErrors(ref, est, pairs).translation_m);
@@ -82,9 +82,9 @@ TEST(EvalRpe, FramesHandExample) {
 // RPE with a 5 deg yaw step at pose 2: rotation error 5 deg on (1,2); the following
 // step is then seen 5 deg off, a translation error of 2 sin(2.5 deg) on a 1 m step.
 TEST(EvalRpe, RotationHandExample) {
-  const PoseTrajectory ref = alongX({0, 1, 2, 3, 4});
-  PoseTrajectory est = ref;
-  for (std::size_t i = 2; i < est.size(); ++i) est[i] = pose(est[i].t_s, est[i].p_m, 0, 0, 5);
+  const core::Trajectory ref = alongX({0, 1, 2, 3, 4});
+  core::Trajectory est = ref;
+  for (std::size_t i = 2; i < est.size(); ++i) est[i] = pose(est[i].t_s, est[i].p_ned_m, 0, 0, 5);
   const RelativeErrors e = rpeErrors(ref, est, rpePairs(est, 1, DeltaUnit::kFrames));
   ASSERT_EQ(e.rotation_deg.size(), 4u);
   EXPECT_NEAR(e.rotation_deg[0], 0.0, 1e-9);
@@ -107,8 +107,8 @@ TEST(EvalRpe, MetersHandExample) {
   ASSERT_EQ(tenths.size(), 1u);
   EXPECT_EQ(tenths[0], (std::pair<std::size_t, std::size_t>{3, 6}));
   // An estimate stretched 10 %: pairs chosen on it (ids 2, 4, 6), each 1.1 m against 1 m.
-  const PoseTrajectory ref = alongX({0, 0.5, 1, 1.5, 2, 2.5, 3});
-  const PoseTrajectory est = alongX({0, 0.55, 1.1, 1.65, 2.2, 2.75, 3.3});
+  const core::Trajectory ref = alongX({0, 0.5, 1, 1.5, 2, 2.5, 3});
+  const core::Trajectory est = alongX({0, 0.55, 1.1, 1.65, 2.2, 2.75, 3.3});
   const IndexPairs pairs = rpePairs(est, 1.0, DeltaUnit::kMeters);
   ASSERT_EQ(pairs.size(), 2u);
   const RelativeErrors e = rpeErrors(ref, est, pairs);
@@ -118,8 +118,8 @@ TEST(EvalRpe, MetersHandExample) {
 
 // Thesis eq. 13 and 14 on a constant error of (1, 2, 2) m and (1, 2, 2) deg: both RMSEs are 3.
 TEST(EvalThesis, ConstantKnownError) {
-  PoseTrajectory ref;
-  PoseTrajectory est;
+  core::Trajectory ref;
+  core::Trajectory est;
   const double attitudes[4][3] = {{0, 0, 0}, {10, -20, 45}, {-30, 15, 178.5}, {5, 30, -120}};
   for (int i = 0; i < 4; ++i) {
     const Eigen::Vector3d p(100.0 * i, -50.0 * i, -300);
@@ -135,11 +135,11 @@ TEST(EvalThesis, ConstantKnownError) {
 
 // The --ref/--est evaluation: offset APE without alignment, and the last-line contract.
 TEST(EvalReport, LastLineIsApeTranslationRmse) {
-  PoseTrajectory ref;
-  PoseTrajectory est;
+  core::Trajectory ref;
+  core::Trajectory est;
   for (int i = 0; i < 10; ++i) {
     ref.push_back(pose(i, Eigen::Vector3d(i, i * i * 0.1, std::sin(i))));
-    est.push_back(pose(i + 0.003, ref.back().p_m + Eigen::Vector3d(0.3, 0, 0.4)));
+    est.push_back(pose(i + 0.003, ref.back().p_ned_m + Eigen::Vector3d(0.3, 0, 0.4)));
   }
   EvalOptions options;
   const TrajectoryEvaluation none = evaluateTrajectories(ref, est, options);
@@ -162,9 +162,9 @@ TEST(EvalReport, LastLineIsApeTranslationRmse) {
 
 // Too few associated poses and bad options are one-line errors saying what is wrong.
 TEST(EvalReport, ErrorsAreClear) {
-  const PoseTrajectory ref = alongX({0, 1, 2});
-  PoseTrajectory late = ref;
-  for (StampedPose& p : late) p.t_s += 0.5;
+  const core::Trajectory ref = alongX({0, 1, 2});
+  core::Trajectory late = ref;
+  for (core::StampedPose& p : late) p.t_s += 0.5;
   try {
     evaluateTrajectories(ref, late, EvalOptions{});
     FAIL() << "expected an error";

@@ -1,6 +1,6 @@
 // The per-run evaluation: robustness (tracked_pct), seed 000's metrics, a
-// source that never tracked, reading a log written with core's LcmLogWriter,
-// and the metrics.json round trip. Expected values are worked out by hand.
+// source that never tracked, and the metrics.json round trip. Expected values
+// are worked out by hand.
 
 #include <cmath>
 #include <cstdint>
@@ -12,12 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/bus.h"
 #include "core/frames.h"
-#include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
-#include "nadir/pose_t.hpp"
-#include "nadir/vo_estimate_t.hpp"
 
 namespace nadir::eval {
 namespace {
@@ -27,12 +23,12 @@ std::string tempPath(const std::string& name) {
 }
 
 // A straight truth along north at 10 m/s from 0 to 10 s, sampled at 100 Hz.
-PoseTrajectory straightTruth() {
-  PoseTrajectory truth;
+core::Trajectory straightTruth() {
+  core::Trajectory truth;
   for (int k = 0; k <= 1000; ++k) {
-    StampedPose pose;
+    core::StampedPose pose;
     pose.t_s = k * 0.01;
-    pose.p_m = Eigen::Vector3d(10.0 * pose.t_s, 0, -100);
+    pose.p_ned_m = Eigen::Vector3d(10.0 * pose.t_s, 0, -100);
     truth.push_back(pose);
   }
   return truth;
@@ -46,7 +42,7 @@ std::vector<SourceEstimate> estimatesAt10Hz(int first_frame, StatusOf status_of)
     SourceEstimate e;
     e.t_s = k * 0.1;
     e.status = status_of(k);
-    e.p_m = Eigen::Vector3d(10.0 * e.t_s, 0, -100);
+    e.p_ned_m = Eigen::Vector3d(10.0 * e.t_s, 0, -100);
     estimates.push_back(e);
   }
   return estimates;
@@ -93,15 +89,15 @@ TEST(EvalRunMetrics, SilentHoleHoldsThreePeriods) {
 // Path lengths sample every track_length_interval_s: a 200 Hz estimate that wobbles 1 cm
 // across a 10 m straight flight adds 200 x 2 cm of wobble at every estimate, none at 1 s.
 TEST(EvalRunMetrics, TrackLengthSamplesAtTheInterval) {
-  PoseTrajectory truth;
+  core::Trajectory truth;
   std::vector<SourceEstimate> estimates;
   for (int i = 0; i <= 200; ++i) {
     const double t = 0.005 * i;
     truth.push_back({t, Eigen::Vector3d(10.0 * t, 0, 0), Eigen::Quaterniond::Identity()});
     const double wobble = (i % 2 == 0 ? 0.01 : -0.01);
-    estimates.push_back(SourceEstimate{t, SourceEstimate::kTracking,
-                                       Eigen::Vector3d(10.0 * t, wobble, 0),
-                                       Eigen::Quaterniond::Identity()});
+    estimates.push_back(
+        SourceEstimate{{t, Eigen::Vector3d(10.0 * t, wobble, 0), Eigen::Quaterniond::Identity()},
+                       SourceEstimate::kTracking});
   }
   EvalOptions every;
   every.track_length_interval_s = 0.0;
@@ -115,18 +111,18 @@ TEST(EvalRunMetrics, TrackLengthSamplesAtTheInterval) {
 // length -10 %, end point 10 m = 3.333 % of 300 m, MAE (0 + 10 + 14.142 + 10) / 4.
 TEST(EvalRunMetrics, Seed000SquareVersusScaledSquare) {
   const Eigen::Vector3d corners[4] = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}, {0, 100, 0}};
-  PoseTrajectory truth;
+  core::Trajectory truth;
   for (int k = 0; k <= 30; ++k) {  // 1 Hz, 10 m/s along the sides
     const int side = std::min(k / 10, 2);
     const double u = (k - 10.0 * side) / 10.0;
-    truth.push_back(StampedPose{static_cast<double>(k),
-                                corners[side] + u * (corners[side + 1] - corners[side]),
-                                Eigen::Quaterniond::Identity()});
+    truth.push_back(core::StampedPose{static_cast<double>(k),
+                                      corners[side] + u * (corners[side + 1] - corners[side]),
+                                      Eigen::Quaterniond::Identity()});
   }
   std::vector<SourceEstimate> estimates;
   for (int c = 0; c < 4; ++c) {
-    estimates.push_back(SourceEstimate{10.0 * c, SourceEstimate::kTracking, 0.9 * corners[c],
-                                       Eigen::Quaterniond::Identity()});
+    estimates.push_back(SourceEstimate{{10.0 * c, 0.9 * corners[c], Eigen::Quaterniond::Identity()},
+                                       SourceEstimate::kTracking});
   }
   const SourceMetrics m = evaluateSource(truth, estimates, EvalOptions{});
   EXPECT_NEAR(m.truth_track_length_m, 300.0, 1e-9);
@@ -181,140 +177,6 @@ TEST(EvalRunMetrics, EstimatesOutsideTruthAreSkipped) {
   EXPECT_NE(m.note.find("50 TRACKING estimates outside"), std::string::npos) << m.note;
 }
 
-// ----------------------------------------------------------------- the log
-
-nadir::pose_t truthMessage(std::int64_t utime, const Eigen::Vector3d& p,
-                           const Eigen::Quaterniond& q) {
-  nadir::pose_t msg{};
-  msg.utime = utime;
-  for (int i = 0; i < 3; ++i) msg.pos[i] = p[i];
-  core::quaternionToWire(q, msg.orientation);
-  return msg;
-}
-
-nadir::vo_estimate_t estimateMessage(std::int64_t utime, const std::string& source, int status,
-                                     const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  nadir::vo_estimate_t msg{};
-  msg.utime = utime;
-  msg.source = source;
-  msg.status = static_cast<std::int8_t>(status);
-  msg.pose = truthMessage(utime, p, q);
-  if (status != SourceEstimate::kTracking) {
-    for (double& w : msg.pose.orientation) w = 0;  // not meaningful: must not be refused
-  }
-  return msg;
-}
-
-template <class Msg>
-void writeMessage(core::LcmLogWriter& writer, std::int64_t event_utime, const std::string& channel,
-                  const Msg& msg) {
-  const std::vector<std::uint8_t> bytes = core::encodeMessage(msg);
-  writer.write(event_utime, channel, bytes.data(), bytes.size());
-}
-
-constexpr std::int64_t kStart = 1'700'000'000'000'000;  // UNIX-time utimes, as a live run
-
-// Truth 100 Hz for 2 s; vo_feature 10 Hz (2 INITIALIZING then TRACKING); one ppa; noise.
-std::string writeSampleLog(const std::string& name) {
-  const std::string path = tempPath(name);
-  core::LcmLogWriter writer(path);
-  const Eigen::Quaterniond yaw90(Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()));
-  for (int k = 0; k <= 200; ++k) {
-    const std::int64_t utime = kStart + k * 10'000;
-    // The event stamp differs from the message utime: the message's wins.
-    writeMessage(writer, utime + 777, "POSE_TRUTH",
-                 truthMessage(utime, Eigen::Vector3d(0.2 * k, 1, -50), yaw90));
-    if (k % 10 == 5) {
-      const int frame = k / 10;
-      writeMessage(
-          writer, utime + 777, "POSE_VO_FEATURE",
-          estimateMessage(utime, "vo_feature",
-                          frame < 2 ? SourceEstimate::kInitializing : SourceEstimate::kTracking,
-                          Eigen::Vector3d(0.2 * k + 1.0, 1, -50), yaw90));
-    }
-    if (k == 100) {
-      writeMessage(writer, utime, "POSE_PPA",
-                   estimateMessage(utime, "ppa", SourceEstimate::kLost, Eigen::Vector3d::Zero(),
-                                   Eigen::Quaterniond::Identity()));
-      const std::uint8_t garbage[5] = {1, 2, 3, 4, 5};
-      writer.write(utime, "POSE_TRUTH", garbage, sizeof garbage);
-      writer.write(utime, "IMU", garbage, sizeof garbage);
-    }
-  }
-  return path;
-}
-
-// readRunLog takes truth and estimates with their utimes, names sources by channel,
-// and reports the undecodable truth message as damage.
-TEST(EvalRunLog, ReadsTruthAndEstimatesFromLcmLogWriterLog) {
-  const LogTrajectories log = readRunLog(writeSampleLog("run.lcmlog"));
-  ASSERT_EQ(log.truth.size(), 201u);
-  EXPECT_DOUBLE_EQ(log.truth.front().t_s, 1'700'000'000.0);
-  EXPECT_NEAR(log.truth.back().t_s - log.truth.front().t_s, 2.0, 1e-6);
-  EXPECT_NEAR((log.truth[10].p_m - Eigen::Vector3d(2, 1, -50)).norm(), 0, 1e-12);
-  EXPECT_NEAR(core::rpyFromQuaternion(log.truth[10].q).yaw_rad, std::numbers::pi / 2, 1e-12);
-  ASSERT_EQ(log.sources.size(), 2u);
-  const auto& feature = log.sources.at("vo_feature");
-  ASSERT_EQ(feature.size(), 20u);
-  EXPECT_EQ(feature[0].status, SourceEstimate::kInitializing);
-  EXPECT_EQ(feature[2].status, SourceEstimate::kTracking);
-  EXPECT_NEAR(feature[2].t_s - log.truth.front().t_s, 0.25, 1e-6);
-  ASSERT_EQ(log.sources.at("ppa").size(), 1u);
-  EXPECT_EQ(log.sources.at("ppa")[0].status, SourceEstimate::kLost);
-  EXPECT_NE(log.damage.find("1 undecodable or invalid message on POSE_TRUTH"), std::string::npos)
-      << log.damage;
-
-  // Every TRACKING estimate is 1 m north of the truth.
-  const RunMetrics run = evaluate(log.truth, log.sources, EvalOptions{});
-  const SourceMetrics& m = run.sources.at("vo_feature");
-  EXPECT_NEAR(m.position_rmse_m, 1.0, 1e-6);
-  EXPECT_NEAR(m.rotation_rmse_deg, 0.0, 1e-6);
-  EXPECT_NEAR(m.tracked_pct, 100.0 * 1.75 / 2.0, 1e-6);  // TRACKING from 0.25 s to the end, 2.0 s
-  EXPECT_NEAR(run.truth_track_length_m, 40.0, 1e-9);
-  EXPECT_FALSE(run.sources.at("ppa").initialised);
-
-  // A custom channel map reads another channel set.
-  const LogTrajectories only_ppa = readRunLog(tempPath("run.lcmlog"), {{"POSE_PPA", "chip"}});
-  ASSERT_EQ(only_ppa.sources.size(), 1u);
-  EXPECT_EQ(only_ppa.sources.begin()->first, "chip");
-}
-
-// A truncated log gives what was read and the reader's damage report.
-TEST(EvalRunLog, TruncatedLogReportsDamage) {
-  const std::string path = writeSampleLog("truncated.lcmlog");
-  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 20);
-  const LogTrajectories log = readRunLog(path);
-  EXPECT_EQ(log.truth.size(), 200u);  // the last truth event was cut
-  EXPECT_FALSE(log.damage.empty());
-}
-
-// An empty log, a log without truth and a missing file are errors naming the file.
-TEST(EvalRunLog, EmptyOrTruthlessLogIsAnError) {
-  const std::string empty = tempPath("empty.lcmlog");
-  { core::LcmLogWriter writer(empty); }
-  try {
-    readRunLog(empty);
-    FAIL();
-  } catch (const EvalError& error) {
-    EXPECT_NE(std::string(error.what()).find(empty + ": the log is empty"), std::string::npos)
-        << error.what();
-  }
-  const std::string no_truth = tempPath("no_truth.lcmlog");
-  {
-    core::LcmLogWriter writer(no_truth);
-    writeMessage(writer, kStart, "POSE_PPA",
-                 estimateMessage(kStart, "ppa", SourceEstimate::kLost, Eigen::Vector3d::Zero(),
-                                 Eigen::Quaterniond::Identity()));
-  }
-  try {
-    readRunLog(no_truth);
-    FAIL();
-  } catch (const EvalError& error) {
-    EXPECT_NE(std::string(error.what()).find("no truth"), std::string::npos) << error.what();
-  }
-  EXPECT_THROW(readRunLog(tempPath("does_not_exist.lcmlog")), EvalError);
-}
-
 // ------------------------------------------------------------ metrics.json
 
 void expectSame(double a, double b) {
@@ -341,7 +203,7 @@ TEST(EvalMetricsJson, RoundTrip) {
   sources["vo_feature"] = estimatesAt10Hz(0, [](int k) {
     return k >= 30 && k < 50 ? SourceEstimate::kLost : SourceEstimate::kTracking;
   });
-  for (SourceEstimate& e : sources["vo_feature"]) e.p_m.y() += 0.1 * std::sin(e.t_s);
+  for (SourceEstimate& e : sources["vo_feature"]) e.p_ned_m.y() += 0.1 * std::sin(e.t_s);
   sources["vo_direct"] = estimatesAt10Hz(0, [](int) { return SourceEstimate::kInitializing; });
   EvalOptions options;
   options.align = "none";

@@ -23,6 +23,7 @@
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
 #include "nadir/pose_t.hpp"
+#include "tests/support/lcm_messages.h"
 
 namespace nadir::dataset {
 namespace {
@@ -153,7 +154,7 @@ struct LogContents {
 
 template <class Msg>
 void writeMessage(core::LcmLogWriter& writer, const std::string& channel, const Msg& message) {
-  const std::vector<std::uint8_t> bytes = core::encodeMessage(message);
+  const std::vector<std::uint8_t> bytes = ::nadir::test::encodeMessage(message);
   writer.write(message.utime + kEventClockOffsetUs, channel, bytes.data(), bytes.size());
 }
 

@@ -1,6 +1,8 @@
-// The camera rig's timing in message time and its mounting geometry.
+// The camera rig's timing in message time, its mounting geometry and its camera_info_t.
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "checker_world.h"
 #include "nodes/camera/camera_rig.h"
@@ -86,6 +88,31 @@ TEST(CameraRig, MountGeometry) {
   // Mount pitched 90 deg forward from straight down: the optical axis points at the nose.
   spec.mount_rpy_deg = {0.0, 90.0, 0.0};
   EXPECT_NEAR((spec.T_body_cam().rotation().col(2) - Eigen::Vector3d(1, 0, 0)).norm(), 0.0, 1e-12);
+}
+
+// camera_info_t carries the intrinsics and the mount (down camera: R_body_cam columns (0,1,0),
+// (-1,0,0), (0,0,1)).
+TEST(CameraRig, CameraInfoCarriesIntrinsicsAndMount) {
+  CameraSpec spec;
+  spec.fps = 31.0;
+  spec.mount_position_m = {0.2, -0.1, 0.05};
+  render::CameraIntrinsics k = render::CameraIntrinsics::fromHorizontalFov(1280, 960, 1.4813);
+  k.distortion = {-0.1, 0.01, 0.0, 0.0, 0.0};
+  const msg::CameraInfo info = cameraInfo("down", spec, k, 42);
+  EXPECT_EQ(info.utime, 42);
+  EXPECT_EQ(info.camera_name, "down");
+  EXPECT_EQ(info.width, 1280);
+  EXPECT_EQ(info.fx, k.fx);
+  EXPECT_EQ(info.cx, 639.5);
+  EXPECT_EQ(info.distortion_model, msg::Distortion::RADTAN);
+  ASSERT_EQ(info.distortion.size(), 5u);
+  EXPECT_EQ(info.distortion[0], -0.1);
+  EXPECT_EQ(info.fps, 31.0);
+  EXPECT_EQ(info.p_cam_in_body_m.x(), 0.2);
+  // Rotation of 90 deg about body z: w = cos 45, z = sin 45.
+  EXPECT_NEAR(info.q_body_cam.w(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(info.q_body_cam.z(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(info.q_body_cam.x(), 0.0, 1e-12);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// Recorded trajectories as truth: readers, interpolation, and a flight CSV round trip.
+// Recorded flights replayed as truth: TUM and flight CSV through the replay, its
+// interpolation and rates, and bad files refused with their place.
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +10,9 @@
 
 #include "core/clock.h"
 #include "core/frames.h"
-#include "nodes/sim/trajectory.h"
+#include "core/geodesy.h"
+#include "core/trajectory.h"
+#include "nodes/sim/flight_replay.h"
 #include "nodes/sim/vehicles.h"
 
 namespace nadir::sim {
@@ -28,14 +31,14 @@ double angleBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
 }
 
 // Halfway between two TUM poses: the mean position and half the rotation (yaw 0 -> 90 gives 45).
-TEST(Trajectory, TumInterpolatesLinearlyAndBySlerp) {
+TEST(FlightReplay, TumInterpolatesLinearlyAndBySlerp) {
   const double s = std::sqrt(0.5);
   const std::string path = writeFile("two.tum",
                                      "# t x y z qx qy qz qw\n"
                                      "10.0 0 0 -100 0 0 0 1\n"
                                      "12.0 40 20 -110 0 0 " +
                                          std::to_string(s) + " " + std::to_string(s) + "\n");
-  const Trajectory trajectory = readTumTrajectory(path);
+  const FlightReplay trajectory(core::readTum(path), path);
   const VehicleState mid = trajectory.at(11'000'000);
   EXPECT_NEAR((mid.p_ned_m - Eigen::Vector3d(20, 10, -105)).norm(), 0.0, 1e-9);
   EXPECT_NEAR(core::rpyFromQuaternion(mid.q_world_body).yaw_rad, 45.0 * kDeg, 1e-6);
@@ -50,7 +53,7 @@ TEST(Trajectory, TumInterpolatesLinearlyAndBySlerp) {
 // A fixed-wing flight written as a flight CSV (lat, lon, alt, roll, pitch, yaw) at 10 Hz
 // comes back through the truth stream at its samples exactly (to the file's precision)
 // and between them within the chord error of a 41 m turn (2 m arcs: 1.2 cm).
-TEST(Trajectory, FlightCsvRoundTripsWithinInterpolationError) {
+TEST(FlightReplay, FlightCsvRoundTripsWithinInterpolationError) {
   const core::LocalNedFrame frame(core::geodeticFromDegrees(37.3, -113.0, 1500.0));
   FixedWingParams params;
   params.airspeed_mps = 20.0;
@@ -73,7 +76,8 @@ TEST(Trajectory, FlightCsvRoundTripsWithinInterpolationError) {
       csv += row;
     }
   }
-  const Trajectory trajectory = readFlightCsv(writeFile("flight.csv", csv), frame);
+  const std::string csv_path = writeFile("flight.csv", csv);
+  const FlightReplay trajectory(core::readFlightCsv(csv_path, frame), csv_path);
   double worst_at_samples_m = 0.0, worst_between_m = 0.0, worst_angle_rad = 0.0;
   for (std::size_t i = 39; i + 40 < truth.size(); ++i) {
     const VehicleState replayed = trajectory.at(truth[i].utime);
@@ -94,31 +98,36 @@ TEST(Trajectory, FlightCsvRoundTripsWithinInterpolationError) {
 }
 
 // Bad files are refused naming the file, the line or the missing column.
-TEST(Trajectory, BadInputIsRefusedWithItsPlace) {
+TEST(FlightReplay, BadInputIsRefusedWithItsPlace) {
   const core::LocalNedFrame frame(core::geodeticFromDegrees(37.3, -113.0, 1500.0));
   const auto message = [](auto&& f) {
     try {
       f();
-    } catch (const TrajectoryError& error) {
+    } catch (const core::TrajectoryError& error) {
       return std::string(error.what());
     }
     return std::string("no error");
   };
   const std::string one = writeFile("one.tum", "1.0 0 0 0 0 0 0 1\n");
-  EXPECT_NE(message([&] { readTumTrajectory(one); }).find("at least two poses"), std::string::npos);
+  EXPECT_NE(message([&] { FlightReplay(core::readTum(one), one); }).find("at least two poses"),
+            std::string::npos);
   const std::string back = writeFile("back.tum", "2.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0 1\n");
-  EXPECT_NE(message([&] { readTumTrajectory(back); }).find("back.tum:2"), std::string::npos);
+  EXPECT_NE(message([&] { FlightReplay(core::readTum(back), back); }).find("back.tum:2"),
+            std::string::npos);
   const std::string short_line = writeFile("short.tum", "1.0 0 0 0 0 0 0 1\n2.0 0 0\n");
-  EXPECT_NE(message([&] { readTumTrajectory(short_line); }).find("short.tum:2"), std::string::npos);
+  EXPECT_NE(
+      message([&] { FlightReplay(core::readTum(short_line), short_line); }).find("short.tum:2"),
+      std::string::npos);
   const std::string no_yaw =
       writeFile("noyaw.csv", "time_s,lat_deg,lon_deg,alt_m,roll_deg,pitch_deg\n");
-  EXPECT_NE(message([&] { readFlightCsv(no_yaw, frame); }).find("'yaw_deg'"), std::string::npos);
+  EXPECT_NE(message([&] { core::readFlightCsv(no_yaw, frame); }).find("'yaw_deg'"),
+            std::string::npos);
   const std::string bad_number = writeFile("bad.csv",
                                            "time_s,lat_deg,lon_deg,alt_m,roll_deg,pitch_deg,yaw_"
                                            "deg\n0,37.3,-113,1500,0,0,0\n1,37.3,-113,abc,0,0,0\n");
-  EXPECT_NE(message([&] { readFlightCsv(bad_number, frame); }).find("bad.csv:3: 'abc'"),
+  EXPECT_NE(message([&] { core::readFlightCsv(bad_number, frame); }).find("bad.csv:3: 'abc'"),
             std::string::npos);
-  EXPECT_NE(message([&] { readTumTrajectory("/nonexistent/x.tum"); }).find("/nonexistent/x.tum"),
+  EXPECT_NE(message([&] { core::readTum("/nonexistent/x.tum"); }).find("/nonexistent/x.tum"),
             std::string::npos);
 }
 

@@ -1,0 +1,763 @@
+#include "lcmtypes/codec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/frames.h"
+#include "nadir/attitude_t.hpp"
+#include "nadir/baro_t.hpp"
+#include "nadir/body_rates_t.hpp"
+#include "nadir/camera_info_t.hpp"
+#include "nadir/geodetic_position_t.hpp"
+#include "nadir/gps_t.hpp"
+#include "nadir/heartbeat_t.hpp"
+#include "nadir/image_t.hpp"
+#include "nadir/imu_t.hpp"
+#include "nadir/pose_t.hpp"
+#include "nadir/ppa_odometry_t.hpp"
+#include "nadir/range_t.hpp"
+#include "nadir/target_detection_t.hpp"
+#include "nadir/velocity_t.hpp"
+#include "nadir/vo_command_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+
+namespace nadir::msg {
+namespace {
+
+// ---------------------------------------------------------------- bytes
+
+template <class Lcm>
+Bytes toBytes(const Lcm& message) {
+  Bytes bytes(static_cast<std::size_t>(message.getEncodedSize()));
+  if (message.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0) {
+    throw std::logic_error(std::string("cannot encode ") + Lcm::getTypeName());
+  }
+  return bytes;
+}
+
+std::int64_t fingerprintOf(const void* data, std::size_t size) {
+  if (data == nullptr || size < 8) return 0;
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  std::uint64_t hash = 0;
+  for (int i = 0; i < 8; ++i) hash = (hash << 8) | bytes[i];
+  return static_cast<std::int64_t>(hash);
+}
+
+template <class Lcm>
+Lcm fromBytes(const void* data, std::size_t size) {
+  if (fingerprintOf(data, size) != Lcm::getHash()) {
+    const std::string actual = typeName(data, size);
+    throw DecodeError(std::to_string(size) + " bytes are not a " + Lcm::getTypeName() +
+                      (actual.empty() ? std::string() : " (they are a " + actual + ")"));
+  }
+  Lcm message;
+  if (message.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) {
+    throw DecodeError(std::to_string(size) + " bytes are not a whole " + Lcm::getTypeName() +
+                      " (truncated or padded)");
+  }
+  return message;
+}
+
+// ---------------------------------------------------------------- fields
+
+void put3(const Eigen::Vector3d& v, double out[3]) {
+  for (int i = 0; i < 3; ++i) out[i] = v[i];
+}
+
+Eigen::Vector3d get3(const double in[3]) { return {in[0], in[1], in[2]}; }
+
+// Names the message in errors: "pose_t at utime 123".
+template <class Lcm>
+std::string where(const Lcm& message) {
+  return std::string(Lcm::getTypeName()) + " at utime " + std::to_string(message.utime);
+}
+
+void requireFinite(const double* values, int count, const std::string& field,
+                   const std::string& where) {
+  for (int i = 0; i < count; ++i) {
+    if (!std::isfinite(values[i])) {
+      throw InvalidMessage(where + ": " + field + "[" + std::to_string(i) + "] is not finite (" +
+                           std::to_string(values[i]) + ")");
+    }
+  }
+}
+
+void requireFinite(double value, const std::string& field, const std::string& where) {
+  if (!std::isfinite(value)) {
+    throw InvalidMessage(where + ": " + field + " is not finite (" + std::to_string(value) + ")");
+  }
+}
+
+Eigen::Quaterniond rotationFromWire(const double wxyz[4], const std::string& field,
+                                    const std::string& where) {
+  requireFinite(wxyz, 4, field, where);
+  try {
+    return core::quaternionFromWire(wxyz);
+  } catch (const std::invalid_argument& error) {
+    const double norm = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).norm();
+    throw InvalidMessage(where + ": " + field + ": " + error.what() + " (norm " +
+                         std::to_string(norm) + ", must be within 1e-3 of 1)");
+  }
+}
+
+// An enum from its wire value, refusing values the type does not define.
+template <class Enum>
+Enum enumFromWire(int value, int count, const std::string& field, const std::string& where) {
+  if (value < 0 || value >= count) {
+    throw InvalidMessage(where + ": " + field + " " + std::to_string(value) + " is not defined");
+  }
+  return static_cast<Enum>(value);
+}
+
+// ---------------------------------------------------------------- pose_t
+
+nadir::pose_t poseToLcm(const Pose& pose) {
+  nadir::pose_t out{};
+  out.utime = pose.utime;
+  put3(pose.p_ned_m, out.pos);
+  put3(pose.v_ned_mps, out.vel);
+  core::quaternionToWire(pose.q_world_body, out.orientation);
+  put3(pose.omega_body_rps, out.rotation_rate);
+  put3(pose.a_ned_mps2, out.accel);
+  return out;
+}
+
+// Position and orientation must be valid; the rates are taken as sent (other
+// systems' logs leave them unset).
+Pose poseFromLcm(const nadir::pose_t& in) {
+  const std::string at = where(in);
+  requireFinite(in.pos, 3, "pos", at);
+  Pose pose;
+  pose.utime = in.utime;
+  pose.p_ned_m = get3(in.pos);
+  pose.v_ned_mps = get3(in.vel);
+  pose.a_ned_mps2 = get3(in.accel);
+  pose.q_world_body = rotationFromWire(in.orientation, "orientation", at);
+  pose.omega_body_rps = get3(in.rotation_rate);
+  return pose;
+}
+
+// ---------------------------------------------------------------- image_t
+
+Image imageFromLcm(const nadir::image_t& message) {
+  const auto fail = [&](const std::string& what) {
+    return InvalidMessage("image_t " + std::to_string(message.width) + "x" +
+                          std::to_string(message.height) + " at utime " +
+                          std::to_string(message.utime) + ": " + what);
+  };
+  Image image;
+  image.utime = message.utime;
+  for (const nadir::image_metadata_t& entry : message.metadata) {
+    image.metadata.emplace_back(entry.key, entry.value);
+  }
+  if (message.size != static_cast<std::int32_t>(message.data.size())) {
+    throw fail("size field " + std::to_string(message.size) + " but " +
+               std::to_string(message.data.size()) + " bytes of data");
+  }
+  if (message.width <= 0 || message.height <= 0) throw fail("no pixels");
+  if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_MJPEG) {
+    cv::Mat decoded = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
+    if (decoded.empty()) throw fail("JPEG data does not decode");
+    if (decoded.cols != message.width || decoded.rows != message.height) {
+      throw fail("JPEG is " + std::to_string(decoded.cols) + "x" + std::to_string(decoded.rows));
+    }
+    if (decoded.channels() == 3) cv::cvtColor(decoded, decoded, cv::COLOR_BGR2RGB);
+    image.pixels = decoded;
+    return image;
+  }
+  int channels = 0;
+  switch (message.pixelformat) {
+    case nadir::image_t::PIXEL_FORMAT_GRAY:
+      channels = 1;
+      break;
+    case nadir::image_t::PIXEL_FORMAT_RGB:
+    case nadir::image_t::PIXEL_FORMAT_BGR:
+      channels = 3;
+      break;
+    default:
+      throw fail("unsupported pixel format " + std::to_string(message.pixelformat));
+  }
+  if (message.row_stride < message.width * channels ||
+      static_cast<std::int64_t>(message.row_stride) * message.height > message.size) {
+    throw fail("row stride " + std::to_string(message.row_stride) + " does not fit " +
+               std::to_string(message.size) + " bytes");
+  }
+  const cv::Mat view(message.height, message.width, channels == 1 ? CV_8UC1 : CV_8UC3,
+                     const_cast<std::uint8_t*>(message.data.data()),
+                     static_cast<std::size_t>(message.row_stride));
+  image.pixels = view.clone();
+  if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_BGR)
+    cv::cvtColor(image.pixels, image.pixels, cv::COLOR_BGR2RGB);
+  return image;
+}
+
+// ---------------------------------------------------------------- the type table
+
+// Each nadir type's name by fingerprint, for typeName().
+struct KnownType {
+  std::int64_t hash;
+  const char* name;
+};
+
+template <class... Lcm>
+std::vector<KnownType> knownTypes() {
+  return {KnownType{Lcm::getHash(), Lcm::getTypeName()}...};
+}
+
+// The generated type of each plain struct.
+template <class T>
+struct LcmOf;
+template <>
+struct LcmOf<Pose> {
+  using type = nadir::pose_t;
+};
+template <>
+struct LcmOf<Imu> {
+  using type = nadir::imu_t;
+};
+template <>
+struct LcmOf<Range> {
+  using type = nadir::range_t;
+};
+template <>
+struct LcmOf<Gps> {
+  using type = nadir::gps_t;
+};
+template <>
+struct LcmOf<Baro> {
+  using type = nadir::baro_t;
+};
+template <>
+struct LcmOf<GeodeticPosition> {
+  using type = nadir::geodetic_position_t;
+};
+template <>
+struct LcmOf<Attitude> {
+  using type = nadir::attitude_t;
+};
+template <>
+struct LcmOf<Velocity> {
+  using type = nadir::velocity_t;
+};
+template <>
+struct LcmOf<BodyRates> {
+  using type = nadir::body_rates_t;
+};
+template <>
+struct LcmOf<CameraInfo> {
+  using type = nadir::camera_info_t;
+};
+template <>
+struct LcmOf<Image> {
+  using type = nadir::image_t;
+};
+template <>
+struct LcmOf<VoEstimate> {
+  using type = nadir::vo_estimate_t;
+};
+template <>
+struct LcmOf<PpaOdometry> {
+  using type = nadir::ppa_odometry_t;
+};
+template <>
+struct LcmOf<TargetDetection> {
+  using type = nadir::target_detection_t;
+};
+template <>
+struct LcmOf<VoCommand> {
+  using type = nadir::vo_command_t;
+};
+template <>
+struct LcmOf<Heartbeat> {
+  using type = nadir::heartbeat_t;
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------- helpers of the structs
+
+Eigen::Isometry3d CameraInfo::T_body_cam() const {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q_body_cam.toRotationMatrix();
+  T.translation() = p_cam_in_body_m;
+  return T;
+}
+
+bool CameraInfo::distorted() const {
+  return std::any_of(distortion.begin(), distortion.end(), [](double k) { return k != 0.0; });
+}
+
+std::string Image::metadataText(const std::string& key) const {
+  for (const auto& [name, value] : metadata) {
+    if (name == key) return std::string(value.begin(), value.end());
+  }
+  return {};
+}
+
+// ---------------------------------------------------------------- encode
+
+Bytes encode(const Pose& message) { return toBytes(poseToLcm(message)); }
+
+Bytes encode(const Imu& message) {
+  nadir::imu_t out{};
+  out.utime = message.utime;
+  put3(message.angular_velocity_rps, out.angular_velocity_rps);
+  put3(message.linear_acceleration_mps2, out.linear_acceleration_mps2);
+  return toBytes(out);
+}
+
+Bytes encode(const Range& message) {
+  nadir::range_t out{};
+  out.utime = message.utime;
+  out.range_m = message.range_m;
+  out.min_range_m = message.min_range_m;
+  out.max_range_m = message.max_range_m;
+  put3(message.direction_body, out.direction_body);
+  switch (message.status) {
+    case RangeStatus::VALID:
+      out.status = nadir::range_t::STATUS_VALID;
+      break;
+    case RangeStatus::TOO_CLOSE:
+      out.status = nadir::range_t::STATUS_TOO_CLOSE;
+      break;
+    case RangeStatus::OUT_OF_RANGE:
+      out.status = nadir::range_t::STATUS_OUT_OF_RANGE;
+      break;
+  }
+  return toBytes(out);
+}
+
+Bytes encode(const Gps& message) {
+  nadir::gps_t out{};
+  out.utime = message.utime;
+  out.latitude_rad = message.lat_rad;
+  out.longitude_rad = message.lon_rad;
+  out.altitude_m = message.alt_m;
+  put3(message.velocity_ned_mps, out.velocity_ned_mps);
+  out.horizontal_accuracy_m = message.horizontal_accuracy_m;
+  out.vertical_accuracy_m = message.vertical_accuracy_m;
+  out.num_satellites = static_cast<std::int16_t>(
+      std::clamp<int>(message.num_satellites, 0, std::numeric_limits<std::int16_t>::max()));
+  // GpsFix lists gps_t's FIX_* values in their order.
+  out.fix_type = static_cast<std::int8_t>(message.fix);
+  return toBytes(out);
+}
+
+Bytes encode(const Baro& message) {
+  nadir::baro_t out{};
+  out.utime = message.utime;
+  out.altitude_m = message.altitude_m;
+  out.pressure_pa = message.pressure_pa;
+  return toBytes(out);
+}
+
+Bytes encode(const GeodeticPosition& message) {
+  nadir::geodetic_position_t out{};
+  out.utime = message.utime;
+  out.latitude_rad = message.lat_rad;
+  out.longitude_rad = message.lon_rad;
+  out.altitude_m = message.alt_m;
+  out.altitude_rel_m = message.alt_rel_m;
+  return toBytes(out);
+}
+
+Bytes encode(const Attitude& message) {
+  nadir::attitude_t out{};
+  out.utime = message.utime;
+  core::quaternionToWire(message.q_world_body, out.orientation);
+  out.roll_rad = message.roll_rad;
+  out.pitch_rad = message.pitch_rad;
+  out.yaw_rad = message.yaw_rad;
+  return toBytes(out);
+}
+
+Bytes encode(const Velocity& message) {
+  nadir::velocity_t out{};
+  out.utime = message.utime;
+  put3(message.v_ned_mps, out.velocity_ned_mps);
+  return toBytes(out);
+}
+
+Bytes encode(const BodyRates& message) {
+  nadir::body_rates_t out{};
+  out.utime = message.utime;
+  put3(message.omega_body_dps, out.angular_velocity_dps);
+  return toBytes(out);
+}
+
+Bytes encode(const CameraInfo& message) {
+  nadir::camera_info_t out{};
+  out.utime = message.utime;
+  out.camera_name = message.camera_name;
+  out.width = message.width;
+  out.height = message.height;
+  out.fx = message.fx;
+  out.fy = message.fy;
+  out.cx = message.cx;
+  out.cy = message.cy;
+  // Distortion lists camera_info_t's DISTORTION_* values in their order.
+  out.distortion_model = static_cast<std::int8_t>(message.distortion_model);
+  out.distortion = message.distortion;
+  out.num_distortion = static_cast<std::int32_t>(out.distortion.size());
+  out.fps = message.fps;
+  put3(message.p_cam_in_body_m, out.position_cam_in_body_m);
+  core::quaternionToWire(message.q_body_cam, out.orientation_body_cam);
+  return toBytes(out);
+}
+
+Bytes encode(const Image& message) {
+  const cv::Mat& pixels = message.pixels;
+  const bool gray = pixels.channels() == 1;
+  nadir::image_t out{};
+  out.utime = message.utime;
+  out.width = pixels.cols;
+  out.height = pixels.rows;
+  if (message.jpeg_quality > 0) {
+    cv::Mat bgr;
+    if (!gray) cv::cvtColor(pixels, bgr, cv::COLOR_RGB2BGR);
+    std::vector<std::uint8_t> jpeg;
+    cv::imencode(".jpg", gray ? pixels : bgr, jpeg,
+                 {cv::IMWRITE_JPEG_QUALITY, std::min(message.jpeg_quality, 100)});
+    out.row_stride = 0;
+    out.pixelformat = nadir::image_t::PIXEL_FORMAT_MJPEG;
+    out.data = std::move(jpeg);
+  } else {
+    out.row_stride = pixels.cols * pixels.channels();
+    out.pixelformat = gray ? std::int32_t{nadir::image_t::PIXEL_FORMAT_GRAY}
+                           : std::int32_t{nadir::image_t::PIXEL_FORMAT_RGB};
+    const cv::Mat continuous = pixels.isContinuous() ? pixels : pixels.clone();
+    out.data.assign(continuous.data, continuous.data + continuous.total() * continuous.elemSize());
+  }
+  out.size = static_cast<std::int32_t>(out.data.size());
+  for (const auto& [key, value] : message.metadata) {
+    nadir::image_metadata_t entry;
+    entry.key = key;
+    entry.value = value;
+    entry.n = static_cast<std::int32_t>(value.size());
+    out.metadata.push_back(std::move(entry));
+  }
+  out.nmetadata = static_cast<std::int32_t>(out.metadata.size());
+  return toBytes(out);
+}
+
+Bytes encode(const VoEstimate& message) {
+  nadir::vo_estimate_t out{};
+  out.utime = message.utime;
+  out.source = message.source;
+  // VoStatus lists vo_estimate_t's STATUS_* values in their order.
+  out.status = static_cast<std::int8_t>(message.status);
+  out.pose.utime = message.utime;
+  put3(message.p_ned_m, out.pose.pos);
+  core::quaternionToWire(message.q_world_body, out.pose.orientation);
+  out.num_features = message.num_features;
+  out.num_resets = message.num_resets;
+  out.processing_time_s = message.processing_time_s;
+  return toBytes(out);
+}
+
+Bytes encode(const PpaOdometry& message) {
+  nadir::ppa_odometry_t out{};
+  out.utime = message.utime;
+  out.frame_index = message.frame_index;
+  out.translation_x_px = message.translation_x_px;
+  out.translation_y_px = message.translation_y_px;
+  out.rotation_rad = message.rotation_rad;
+  out.scale = message.scale;
+  out.strength = message.strength;
+  out.new_keyframe = message.new_keyframe;
+  out.keyframe_edge_count = message.keyframe_edge_count;
+  out.instruction_count = message.instruction_count;
+  return toBytes(out);
+}
+
+Bytes encode(const TargetDetection& message) {
+  nadir::target_detection_t out{};
+  out.utime = message.utime;
+  // TargetKind lists target_detection_t's KIND_* values in their order.
+  out.kind = static_cast<std::int8_t>(message.kind);
+  out.detected = message.detected;
+  out.x_min_px = message.x_min_px;
+  out.y_min_px = message.y_min_px;
+  out.x_max_px = message.x_max_px;
+  out.y_max_px = message.y_max_px;
+  out.center_x_px = message.center_x_px;
+  out.center_y_px = message.center_y_px;
+  out.num_boundaries = message.num_boundaries;
+  for (const Eigen::Vector2d& point : message.points_px) {
+    out.points_px.push_back({point.x(), point.y()});
+  }
+  out.num_points = static_cast<std::int32_t>(out.points_px.size());
+  return toBytes(out);
+}
+
+Bytes encode(const VoCommand& message) {
+  nadir::vo_command_t out{};
+  out.utime = message.utime;
+  out.target = message.target;
+  out.command = nadir::vo_command_t::COMMAND_RESET;
+  out.has_initial_pose = message.initial_pose.has_value();
+  if (message.initial_pose) out.initial_pose = poseToLcm(*message.initial_pose);
+  return toBytes(out);
+}
+
+Bytes encode(const Heartbeat& message) {
+  nadir::heartbeat_t out{};
+  out.utime = message.utime;
+  out.node = message.node;
+  out.pid = message.pid;
+  out.sequence = message.sequence;
+  out.summary = message.summary;
+  return toBytes(out);
+}
+
+// ---------------------------------------------------------------- decode
+
+template <>
+Pose decode<Pose>(const void* data, std::size_t size) {
+  return poseFromLcm(fromBytes<nadir::pose_t>(data, size));
+}
+
+template <>
+Imu decode<Imu>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::imu_t>(data, size);
+  return {in.utime, get3(in.angular_velocity_rps), get3(in.linear_acceleration_mps2)};
+}
+
+template <>
+Range decode<Range>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::range_t>(data, size);
+  Range out;
+  out.utime = in.utime;
+  out.range_m = in.range_m;
+  out.status = enumFromWire<RangeStatus>(in.status, 3, "status", where(in));
+  out.direction_body = get3(in.direction_body);
+  out.min_range_m = in.min_range_m;
+  out.max_range_m = in.max_range_m;
+  if (out.status == RangeStatus::VALID) requireFinite(in.range_m, "range_m", where(in));
+  return out;
+}
+
+template <>
+Gps decode<Gps>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::gps_t>(data, size);
+  Gps out;
+  out.utime = in.utime;
+  out.lat_rad = in.latitude_rad;
+  out.lon_rad = in.longitude_rad;
+  out.alt_m = in.altitude_m;
+  out.velocity_ned_mps = get3(in.velocity_ned_mps);
+  out.horizontal_accuracy_m = in.horizontal_accuracy_m;
+  out.vertical_accuracy_m = in.vertical_accuracy_m;
+  out.num_satellites = in.num_satellites;
+  out.fix = enumFromWire<GpsFix>(in.fix_type, 5, "fix_type", where(in));
+  return out;
+}
+
+template <>
+Baro decode<Baro>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::baro_t>(data, size);
+  return {in.utime, in.altitude_m, in.pressure_pa};
+}
+
+template <>
+GeodeticPosition decode<GeodeticPosition>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::geodetic_position_t>(data, size);
+  const std::string at = where(in);
+  requireFinite(in.latitude_rad, "latitude_rad", at);
+  requireFinite(in.longitude_rad, "longitude_rad", at);
+  requireFinite(in.altitude_m, "altitude_m", at);
+  if (std::abs(in.latitude_rad) > std::numbers::pi / 2) {
+    throw InvalidMessage(at + ": latitude_rad " + std::to_string(in.latitude_rad) +
+                         " is beyond a pole");
+  }
+  return {in.utime, in.latitude_rad, in.longitude_rad, in.altitude_m, in.altitude_rel_m};
+}
+
+template <>
+Attitude decode<Attitude>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::attitude_t>(data, size);
+  return {in.utime, rotationFromWire(in.orientation, "orientation", where(in)), in.roll_rad,
+          in.pitch_rad, in.yaw_rad};
+}
+
+template <>
+Velocity decode<Velocity>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::velocity_t>(data, size);
+  return {in.utime, get3(in.velocity_ned_mps)};
+}
+
+template <>
+BodyRates decode<BodyRates>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::body_rates_t>(data, size);
+  return {in.utime, get3(in.angular_velocity_dps)};
+}
+
+template <>
+CameraInfo decode<CameraInfo>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::camera_info_t>(data, size);
+  const std::string at = where(in);
+  if (in.width <= 0 || in.height <= 0) {
+    throw InvalidMessage(at + ": " + std::to_string(in.width) + "x" + std::to_string(in.height) +
+                         " is not an image size");
+  }
+  for (const auto& [name, value] :
+       {std::pair{"fx", in.fx}, std::pair{"fy", in.fy}, std::pair{"cx", in.cx},
+        std::pair{"cy", in.cy}, std::pair{"fps", in.fps}}) {
+    requireFinite(value, name, at);
+  }
+  if (in.fx <= 0 || in.fy <= 0) throw InvalidMessage(at + ": a focal length is not positive");
+  requireFinite(in.distortion.data(), static_cast<int>(in.distortion.size()), "distortion", at);
+  requireFinite(in.position_cam_in_body_m, 3, "position_cam_in_body_m", at);
+  CameraInfo out;
+  out.utime = in.utime;
+  out.camera_name = in.camera_name;
+  out.width = in.width;
+  out.height = in.height;
+  out.fx = in.fx;
+  out.fy = in.fy;
+  out.cx = in.cx;
+  out.cy = in.cy;
+  out.distortion_model = enumFromWire<Distortion>(in.distortion_model, 3, "distortion_model", at);
+  out.distortion = in.distortion;
+  out.fps = in.fps;
+  out.p_cam_in_body_m = get3(in.position_cam_in_body_m);
+  out.q_body_cam = rotationFromWire(in.orientation_body_cam, "orientation_body_cam", at);
+  return out;
+}
+
+template <>
+Image decode<Image>(const void* data, std::size_t size) {
+  return imageFromLcm(fromBytes<nadir::image_t>(data, size));
+}
+
+template <>
+VoEstimate decode<VoEstimate>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::vo_estimate_t>(data, size);
+  const std::string at = where(in);
+  VoEstimate out;
+  out.utime = in.utime;
+  out.source = in.source;
+  out.status = enumFromWire<VoStatus>(in.status, 3, "status", at);
+  out.num_features = in.num_features;
+  out.num_resets = in.num_resets;
+  out.processing_time_s = in.processing_time_s;
+  out.p_ned_m = get3(in.pose.pos);
+  if (out.status == VoStatus::TRACKING) {
+    requireFinite(in.pose.pos, 3, "pose.pos", at);
+    out.q_world_body = rotationFromWire(in.pose.orientation, "pose.orientation", at);
+  } else {
+    try {
+      out.q_world_body = core::quaternionFromWire(in.pose.orientation);
+    } catch (const std::invalid_argument&) {
+      out.q_world_body = Eigen::Quaterniond::Identity();
+    }
+  }
+  return out;
+}
+
+template <>
+PpaOdometry decode<PpaOdometry>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::ppa_odometry_t>(data, size);
+  PpaOdometry out;
+  out.utime = in.utime;
+  out.frame_index = in.frame_index;
+  out.translation_x_px = in.translation_x_px;
+  out.translation_y_px = in.translation_y_px;
+  out.rotation_rad = in.rotation_rad;
+  out.scale = in.scale;
+  out.strength = in.strength;
+  out.new_keyframe = in.new_keyframe;
+  out.keyframe_edge_count = in.keyframe_edge_count;
+  out.instruction_count = in.instruction_count;
+  return out;
+}
+
+template <>
+TargetDetection decode<TargetDetection>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::target_detection_t>(data, size);
+  TargetDetection out;
+  out.utime = in.utime;
+  out.kind = enumFromWire<TargetKind>(in.kind, 2, "kind", where(in));
+  out.detected = in.detected;
+  out.x_min_px = in.x_min_px;
+  out.y_min_px = in.y_min_px;
+  out.x_max_px = in.x_max_px;
+  out.y_max_px = in.y_max_px;
+  out.center_x_px = in.center_x_px;
+  out.center_y_px = in.center_y_px;
+  out.num_boundaries = in.num_boundaries;
+  for (const std::vector<double>& point : in.points_px)
+    out.points_px.emplace_back(point[0], point[1]);
+  return out;
+}
+
+template <>
+VoCommand decode<VoCommand>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::vo_command_t>(data, size);
+  VoCommand out;
+  out.utime = in.utime;
+  out.target = in.target;
+  out.command = enumFromWire<VoCommand::Kind>(in.command, 1, "command", where(in));
+  if (in.has_initial_pose) out.initial_pose = poseFromLcm(in.initial_pose);
+  return out;
+}
+
+template <>
+Heartbeat decode<Heartbeat>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::heartbeat_t>(data, size);
+  return {in.utime, in.node, in.pid, in.sequence, in.summary};
+}
+
+// ---------------------------------------------------------------- types
+
+template <class T>
+bool isType(const void* data, std::size_t size) {
+  return fingerprintOf(data, size) == LcmOf<T>::type::getHash();
+}
+
+template <class T>
+const char* typeNameOf() {
+  return LcmOf<T>::type::getTypeName();
+}
+
+#define NADIR_MSG_TYPE(T)                            \
+  template bool isType<T>(const void*, std::size_t); \
+  template const char* typeNameOf<T>();
+NADIR_MSG_TYPE(Pose)
+NADIR_MSG_TYPE(Imu)
+NADIR_MSG_TYPE(Range)
+NADIR_MSG_TYPE(Gps)
+NADIR_MSG_TYPE(Baro)
+NADIR_MSG_TYPE(GeodeticPosition)
+NADIR_MSG_TYPE(Attitude)
+NADIR_MSG_TYPE(Velocity)
+NADIR_MSG_TYPE(BodyRates)
+NADIR_MSG_TYPE(CameraInfo)
+NADIR_MSG_TYPE(Image)
+NADIR_MSG_TYPE(VoEstimate)
+NADIR_MSG_TYPE(PpaOdometry)
+NADIR_MSG_TYPE(TargetDetection)
+NADIR_MSG_TYPE(VoCommand)
+NADIR_MSG_TYPE(Heartbeat)
+#undef NADIR_MSG_TYPE
+
+std::string typeName(const void* data, std::size_t size) {
+  static const std::vector<KnownType> kTypes =
+      knownTypes<nadir::pose_t, nadir::imu_t, nadir::range_t, nadir::gps_t, nadir::baro_t,
+                 nadir::geodetic_position_t, nadir::attitude_t, nadir::velocity_t,
+                 nadir::body_rates_t, nadir::camera_info_t, nadir::image_t, nadir::vo_estimate_t,
+                 nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
+                 nadir::heartbeat_t>();
+  const std::int64_t hash = fingerprintOf(data, size);
+  for (const KnownType& type : kTypes) {
+    if (type.hash == hash) return type.name;
+  }
+  return {};
+}
+
+}  // namespace nadir::msg

@@ -1,0 +1,74 @@
+#pragma once
+// A run's trajectories as they were recorded or are being received: the truth
+// (pose_t) and every VO source's estimates (vo_estimate_t), stamped with the
+// messages' utime. Estimates are found by their type on whatever channel they
+// come, and named by their `source` field (the node's registry name), so a
+// renamed channel is never missed. The truth is pose_t on the channel given,
+// or, when none is given, on the one channel of the log that carries pose_t.
+
+#include <cstddef>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/trajectory.h"
+
+namespace nadir::logs {
+
+// A log that cannot be read as a run: the message names the file.
+class RunLogError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One estimate of a source as it arrived. The pose means something only when
+// TRACKING; status is vo_estimate_t's.
+struct SourceEstimate : core::StampedPose {
+  static constexpr int kInitializing = 0;
+  static constexpr int kTracking = 1;
+  static constexpr int kLost = 2;
+  int status = kInitializing;
+};
+
+struct LogTrajectories {
+  core::Trajectory truth;  // sorted by stamp, one pose per stamp
+  std::string truth_channel;
+  std::map<std::string, std::vector<SourceEstimate>> sources;  // by source name, sorted
+  std::string damage;  // the reader's damage report and what was left out; empty if clean
+};
+
+// Gathers the truth and the estimates one message at a time: from the events
+// of a log (readRunLog) or from a live bus (the viewers' live mode).
+class TrajectoryCollector {
+ public:
+  // truth_channel: where the truth's pose_t is; empty: the channel carrying pose_t.
+  explicit TrajectoryCollector(std::string truth_channel = {});
+  // Takes one message; false if it is neither truth nor an estimate. A message of
+  // either type that does not decode, or holds a non-finite position or a
+  // quaternion that is not a rotation, is counted and left out.
+  bool add(const std::string& channel, const void* data, std::size_t size);
+  std::size_t truthPoses() const;
+  // What was gathered so far. Throws RunLogError when pose_t came on several
+  // channels and none was named the truth's.
+  LogTrajectories trajectories() const;
+
+ private:
+  std::string truth_channel_;
+  std::map<std::string, core::Trajectory> poses_;  // pose_t by channel
+  std::map<std::string, std::vector<SourceEstimate>> sources_;
+  std::map<std::string, std::size_t> undecodable_;  // channel -> count
+};
+
+// Reads a log's truth and estimates. A damaged log gives what could be read and
+// says what was wrong in `damage`. Throws RunLogError naming the log if it
+// cannot be opened, is empty, or holds no valid truth.
+LogTrajectories readRunLog(const std::string& log_path, const std::string& truth_channel = {});
+
+// The TRACKING estimates as a trajectory, normalised, the first of equal stamps kept.
+core::Trajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates);
+
+// "a; b" joining of notes, for damage reports.
+void appendNote(std::string& notes, const std::string& note);
+
+}  // namespace nadir::logs

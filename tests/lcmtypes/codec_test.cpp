@@ -1,0 +1,371 @@
+// The codecs: each plain struct's fields land in the LCM message's fields (read
+// back with the generated types, not the codec), come back exactly through
+// decode, and bad bytes or bad values are refused with a message saying what.
+
+#include "lcmtypes/codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/frames.h"
+#include "nadir/baro_t.hpp"
+#include "nadir/camera_info_t.hpp"
+#include "nadir/gps_t.hpp"
+#include "nadir/image_t.hpp"
+#include "nadir/imu_t.hpp"
+#include "nadir/pose_t.hpp"
+#include "nadir/range_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
+
+namespace nadir::msg {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The bytes read with the generated type, independently of the codec.
+template <class Lcm>
+Lcm asLcm(const Bytes& bytes) {
+  Lcm message;
+  EXPECT_EQ(message.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  return message;
+}
+
+template <class Lcm>
+Bytes bytesOf(const Lcm& message) {
+  Bytes bytes(static_cast<std::size_t>(message.getEncodedSize()));
+  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+template <class T, class Lcm>
+std::string invalidReason(const Lcm& message) {
+  try {
+    decode<T>(bytesOf(message));
+  } catch (const InvalidMessage& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// A pose with every field set and distinct, with a general (non-axis) attitude.
+Pose makePose(std::int64_t utime, double base) {
+  Pose pose;
+  pose.utime = utime;
+  pose.p_ned_m = Eigen::Vector3d(base + 10.5, -(base + 20.25), -(base + 120.125));
+  pose.v_ned_mps = Eigen::Vector3d(base + 1.5, base - 2.25, 0.375);
+  pose.a_ned_mps2 = Eigen::Vector3d(0.125, -0.25, base * 0.01);
+  pose.q_world_body = core::quaternionFromRpy({(5.0 + base) * kDeg, -3.0 * kDeg, 40.0 * kDeg});
+  pose.omega_body_rps = Eigen::Vector3d(0.01, -0.02, 0.03 + base * 1e-3);
+  return pose;
+}
+
+cv::Mat gradient(int channels) {
+  cv::Mat image(48, 64, channels == 1 ? CV_8UC1 : CV_8UC3);
+  for (int r = 0; r < 48; ++r) {
+    for (int c = 0; c < 64; ++c) {
+      for (int ch = 0; ch < channels; ++ch)
+        image.ptr<std::uint8_t>(r)[c * channels + ch] =
+            static_cast<std::uint8_t>(r * 4 + c + 50 * ch);
+    }
+  }
+  return image;
+}
+
+// ---------------------------------------------------------------- pose_t
+
+// pose_t's fields are the struct's, the wire quaternion w first; decode gives back
+// every field, the quaternion as Eigen normalises it.
+TEST(Codec, PoseRoundTrip) {
+  const Pose pose = makePose(1'700'000'000'123'457, 3.0);
+  const nadir::pose_t wire = asLcm<nadir::pose_t>(encode(pose));
+  EXPECT_EQ(wire.utime, pose.utime);
+  EXPECT_EQ(wire.pos[2], pose.p_ned_m.z());
+  EXPECT_EQ(wire.vel[1], pose.v_ned_mps.y());
+  EXPECT_EQ(wire.accel[2], pose.a_ned_mps2.z());
+  EXPECT_EQ(wire.rotation_rate[2], pose.omega_body_rps.z());
+  EXPECT_EQ(wire.orientation[0], pose.q_world_body.w());
+  EXPECT_EQ(wire.orientation[3], pose.q_world_body.z());
+  const Pose back = decode<Pose>(encode(pose));
+  EXPECT_EQ(back.utime, pose.utime);
+  EXPECT_EQ(back.p_ned_m, pose.p_ned_m);
+  EXPECT_EQ(back.v_ned_mps, pose.v_ned_mps);
+  EXPECT_EQ(back.a_ned_mps2, pose.a_ned_mps2);
+  EXPECT_EQ(back.omega_body_rps, pose.omega_body_rps);
+  EXPECT_EQ(back.q_world_body.coeffs(), pose.q_world_body.normalized().coeffs());
+}
+
+// A non-finite position and a quaternion off unit norm by > 1e-3 are refused, naming
+// the field; < 1e-3 is normalised. Unset rates from other systems pass.
+TEST(Codec, InvalidPoseIsRefused) {
+  nadir::pose_t good = asLcm<nadir::pose_t>(encode(makePose(5, 1.0)));
+
+  nadir::pose_t bad = good;
+  bad.pos[1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(invalidReason<Pose>(bad).find("pos[1]"), std::string::npos) << invalidReason<Pose>(bad);
+  bad = good;
+  bad.orientation[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(invalidReason<Pose>(bad).find("orientation"), std::string::npos);
+  bad = good;
+  for (double& c : bad.orientation) c *= 1.002;
+  EXPECT_NE(invalidReason<Pose>(bad).find("orientation"), std::string::npos);
+
+  nadir::pose_t nearly = good;
+  for (double& c : nearly.orientation) c *= 1.0005;
+  const Pose pose = decode<Pose>(bytesOf(nearly));
+  EXPECT_NEAR(pose.q_world_body.norm(), 1.0, 1e-15);
+  EXPECT_NEAR(pose.q_world_body.w(), good.orientation[0], 1e-15);
+
+  nadir::pose_t no_rates = good;
+  no_rates.accel[0] = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(std::isinf(decode<Pose>(bytesOf(no_rates)).a_ned_mps2.x()));
+}
+
+// ---------------------------------------------------------------- sensors
+
+// imu_t, range_t, gps_t and baro_t carry every field, the enums mapped to the wire's.
+TEST(Codec, SensorMessagesCarryEveryField) {
+  const Imu imu_sample{7, {0.1, -0.2, 0.3}, {0.5, 0.25, -9.80665}};
+  const nadir::imu_t imu = asLcm<nadir::imu_t>(encode(imu_sample));
+  EXPECT_EQ(imu.utime, 7);
+  EXPECT_EQ(imu.angular_velocity_rps[1], -0.2);
+  EXPECT_EQ(imu.angular_velocity_rps[2], 0.3);
+  EXPECT_EQ(imu.linear_acceleration_mps2[0], 0.5);
+  EXPECT_EQ(imu.linear_acceleration_mps2[2], -9.80665);
+  EXPECT_EQ(decode<Imu>(encode(imu_sample)).linear_acceleration_mps2,
+            imu_sample.linear_acceleration_mps2);
+
+  Range range_sample;
+  range_sample.utime = 8;
+  range_sample.range_m = 42.5;
+  range_sample.status = RangeStatus::TOO_CLOSE;
+  range_sample.direction_body = Eigen::Vector3d(0.6, 0.0, 0.8);
+  range_sample.min_range_m = 0.1;
+  range_sample.max_range_m = 100.0;
+  const nadir::range_t range = asLcm<nadir::range_t>(encode(range_sample));
+  EXPECT_EQ(range.utime, 8);
+  EXPECT_EQ(range.range_m, 42.5);
+  EXPECT_EQ(range.min_range_m, 0.1);
+  EXPECT_EQ(range.max_range_m, 100.0);
+  EXPECT_EQ(range.direction_body[0], 0.6);
+  EXPECT_EQ(range.direction_body[2], 0.8);
+  EXPECT_EQ(range.status, std::int8_t{nadir::range_t::STATUS_TOO_CLOSE});
+  range_sample.status = RangeStatus::VALID;
+  EXPECT_EQ(asLcm<nadir::range_t>(encode(range_sample)).status,
+            std::int8_t{nadir::range_t::STATUS_VALID});
+  range_sample.status = RangeStatus::OUT_OF_RANGE;
+  EXPECT_EQ(asLcm<nadir::range_t>(encode(range_sample)).status,
+            std::int8_t{nadir::range_t::STATUS_OUT_OF_RANGE});
+  EXPECT_EQ(decode<Range>(encode(range_sample)).status, RangeStatus::OUT_OF_RANGE);
+
+  Gps gps_sample;
+  gps_sample.utime = 9;
+  gps_sample.lat_rad = 0.65;
+  gps_sample.lon_rad = -1.97;
+  gps_sample.alt_m = 1520.5;
+  gps_sample.velocity_ned_mps = Eigen::Vector3d(20.0, -1.0, 0.5);
+  gps_sample.horizontal_accuracy_m = 1.5;
+  gps_sample.vertical_accuracy_m = 3.0;
+  gps_sample.num_satellites = 12;
+  gps_sample.fix = GpsFix::FIX_3D;
+  const nadir::gps_t gps = asLcm<nadir::gps_t>(encode(gps_sample));
+  EXPECT_EQ(gps.utime, 9);
+  EXPECT_EQ(gps.latitude_rad, 0.65);
+  EXPECT_EQ(gps.longitude_rad, -1.97);
+  EXPECT_EQ(gps.altitude_m, 1520.5);
+  EXPECT_EQ(gps.velocity_ned_mps[0], 20.0);
+  EXPECT_EQ(gps.velocity_ned_mps[2], 0.5);
+  EXPECT_EQ(gps.horizontal_accuracy_m, 1.5);
+  EXPECT_EQ(gps.vertical_accuracy_m, 3.0);
+  EXPECT_EQ(gps.num_satellites, 12);
+  EXPECT_EQ(gps.fix_type, std::int8_t{nadir::gps_t::FIX_3D});
+  EXPECT_EQ(asLcm<nadir::gps_t>(encode(Gps{})).fix_type, std::int8_t{nadir::gps_t::FIX_NONE});
+  EXPECT_EQ(decode<Gps>(encode(gps_sample)).fix, GpsFix::FIX_3D);
+
+  const nadir::baro_t baro = asLcm<nadir::baro_t>(encode(Baro{123456, 1000.0, 89874.6}));
+  EXPECT_EQ(baro.utime, 123456);
+  EXPECT_EQ(baro.altitude_m, 1000.0);
+  EXPECT_EQ(baro.pressure_pa, 89874.6);
+}
+
+// An enum value the type does not define is refused.
+TEST(Codec, UndefinedEnumValueIsRefused) {
+  nadir::range_t range = asLcm<nadir::range_t>(encode(Range{}));
+  range.status = 7;
+  EXPECT_NE(invalidReason<Range>(range).find("status 7"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- image_t
+
+// Raw gray and RGB images survive encode -> bytes -> decode -> pixels exactly.
+TEST(Codec, RawImagesRoundTrip) {
+  for (int channels : {1, 3}) {
+    const Image image{123'456'789, gradient(channels), 0, {{"exposure_s", {'0', '.', '5'}}}};
+    const Bytes bytes = encode(image);
+    const nadir::image_t wire = asLcm<nadir::image_t>(bytes);
+    EXPECT_EQ(wire.utime, 123'456'789);
+    EXPECT_EQ(wire.pixelformat, channels == 1 ? std::int32_t{nadir::image_t::PIXEL_FORMAT_GRAY}
+                                              : std::int32_t{nadir::image_t::PIXEL_FORMAT_RGB});
+    EXPECT_EQ(wire.row_stride, 64 * channels);
+    const Image back = decode<Image>(bytes);
+    EXPECT_EQ(cv::norm(back.pixels, image.pixels, cv::NORM_INF), 0.0);
+    EXPECT_EQ(back.metadataText("exposure_s"), "0.5");
+    EXPECT_EQ(back.metadataText("gain"), "");
+  }
+}
+
+// JPEG images decode to the same size and close to the original pixels.
+TEST(Codec, JpegImagesDecode) {
+  const Image image{0, gradient(3), 95, {}};
+  const Bytes bytes = encode(image);
+  const nadir::image_t wire = asLcm<nadir::image_t>(bytes);
+  EXPECT_EQ(wire.pixelformat, std::int32_t{nadir::image_t::PIXEL_FORMAT_MJPEG});
+  EXPECT_LT(wire.size, 64 * 48 * 3);
+  const cv::Mat pixels = decode<Image>(bytes).pixels;
+  ASSERT_EQ(pixels.type(), CV_8UC3);
+  // JPEG at quality 95 with 4:2:0 chroma: a few counts on average; a swap of R and
+  // B would be off by 100 (the channels differ by 50 each).
+  EXPECT_LT(cv::norm(pixels, image.pixels, cv::NORM_L1) / pixels.total() / 3, 6.0);
+  const cv::Scalar mean_decoded = cv::mean(pixels), mean_original = cv::mean(image.pixels);
+  for (int ch = 0; ch < 3; ++ch)
+    EXPECT_NEAR(mean_decoded[ch], mean_original[ch], 3.0) << "channel " << ch;
+}
+
+// Malformed image_t messages are refused with a message saying what is wrong.
+TEST(Codec, MalformedImagesAreRefused) {
+  const nadir::image_t message = asLcm<nadir::image_t>(encode(Image{0, gradient(1), 0, {}}));
+  nadir::image_t short_data = message;
+  short_data.data.resize(100);
+  short_data.size = 100;
+  EXPECT_NE(invalidReason<Image>(short_data).find("row stride"), std::string::npos);
+  nadir::image_t yuv = message;
+  yuv.pixelformat = nadir::image_t::PIXEL_FORMAT_YUYV;
+  EXPECT_NE(invalidReason<Image>(yuv).find("unsupported pixel format"), std::string::npos);
+  nadir::image_t bad_jpeg = message;
+  bad_jpeg.pixelformat = nadir::image_t::PIXEL_FORMAT_MJPEG;
+  EXPECT_NE(invalidReason<Image>(bad_jpeg).find("JPEG"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- camera_info_t
+
+// camera_info_t's fields are the struct's, and a lens that cannot be one is refused.
+TEST(Codec, CameraInfoRoundTripAndRefusals) {
+  CameraInfo info;
+  info.utime = 42;
+  info.camera_name = "down";
+  info.width = 1280;
+  info.height = 960;
+  info.fx = info.fy = 800.0;
+  info.cx = 639.5;
+  info.cy = 479.5;
+  info.distortion_model = Distortion::EQUIDISTANT;
+  info.distortion = {0.1, -0.01, 0.001, 0.0};
+  info.fps = 31.0;
+  info.p_cam_in_body_m = Eigen::Vector3d(0.2, -0.1, 0.05);
+  info.q_body_cam = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+  const nadir::camera_info_t wire = asLcm<nadir::camera_info_t>(encode(info));
+  EXPECT_EQ(wire.distortion_model, std::int8_t{nadir::camera_info_t::DISTORTION_EQUIDISTANT});
+  EXPECT_EQ(wire.num_distortion, 4);
+  EXPECT_EQ(wire.position_cam_in_body_m[1], -0.1);
+  EXPECT_EQ(wire.orientation_body_cam[3], info.q_body_cam.z());
+  const CameraInfo back = decode<CameraInfo>(encode(info));
+  EXPECT_EQ(back.camera_name, "down");
+  EXPECT_EQ(back.cy, 479.5);
+  EXPECT_EQ(back.distortion, info.distortion);
+  EXPECT_TRUE(back.distorted());
+  EXPECT_NEAR((back.T_body_cam().translation() - info.p_cam_in_body_m).norm(), 0.0, 0.0);
+
+  nadir::camera_info_t bad = wire;
+  bad.fx = 0.0;
+  EXPECT_NE(invalidReason<CameraInfo>(bad).find("focal"), std::string::npos);
+  bad = wire;
+  bad.width = 0;
+  EXPECT_NE(invalidReason<CameraInfo>(bad).find("0x960"), std::string::npos);
+  bad = wire;
+  bad.orientation_body_cam[0] = 3.0;
+  EXPECT_NE(invalidReason<CameraInfo>(bad).find("orientation_body_cam"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- vo_estimate_t
+
+// vo_estimate_t keeps its source and status; the pose must be valid only when TRACKING.
+TEST(Codec, VoEstimateRoundTrip) {
+  VoEstimate estimate;
+  estimate.utime = 1'000'000;
+  estimate.source = "vo_feature";
+  estimate.status = VoStatus::TRACKING;
+  estimate.p_ned_m = Eigen::Vector3d(1, 2, -3);
+  estimate.num_features = 150;
+  estimate.num_resets = 2;
+  estimate.processing_time_s = 0.025;
+  const nadir::vo_estimate_t wire = asLcm<nadir::vo_estimate_t>(encode(estimate));
+  EXPECT_EQ(wire.status, std::int8_t{nadir::vo_estimate_t::STATUS_TRACKING});
+  EXPECT_EQ(wire.pose.utime, 1'000'000);
+  EXPECT_EQ(wire.pose.pos[2], -3.0);
+  const VoEstimate back = decode<VoEstimate>(encode(estimate));
+  EXPECT_EQ(back.source, "vo_feature");
+  EXPECT_EQ(back.p_ned_m, estimate.p_ned_m);
+  EXPECT_EQ(back.num_resets, 2);
+  EXPECT_EQ(back.processing_time_s, 0.025);
+
+  nadir::vo_estimate_t unset = wire;
+  for (double& w : unset.pose.orientation) w = 0;
+  EXPECT_NE(invalidReason<VoEstimate>(unset).find("pose.orientation"), std::string::npos);
+  unset.status = nadir::vo_estimate_t::STATUS_INITIALIZING;
+  EXPECT_EQ(decode<VoEstimate>(bytesOf(unset)).q_world_body.coeffs(),
+            Eigen::Quaterniond::Identity().coeffs());
+}
+
+// ---------------------------------------------------------------- types
+
+// Bytes of another type, or too few, are a DecodeError naming both types; the
+// fingerprint says which type bytes are.
+TEST(Codec, WrongTypeIsADecodeError) {
+  const Bytes pose = encode(makePose(0, 0));
+  EXPECT_TRUE(isType<Pose>(pose.data(), pose.size()));
+  EXPECT_FALSE(isType<Imu>(pose.data(), pose.size()));
+  EXPECT_EQ(typeName(pose.data(), pose.size()), "pose_t");
+  EXPECT_EQ(std::string(typeNameOf<Heartbeat>()), "heartbeat_t");
+  try {
+    decode<Imu>(pose);
+    FAIL() << "a pose_t was decoded as an imu_t";
+  } catch (const DecodeError& error) {
+    EXPECT_NE(std::string(error.what()).find("not a imu_t (they are a pose_t)"), std::string::npos)
+        << error.what();
+  }
+  const Bytes truncated(pose.begin(), pose.end() - 4);
+  EXPECT_THROW(decode<Pose>(truncated), DecodeError);
+  const std::uint8_t three[3] = {1, 2, 3};
+  EXPECT_EQ(typeName(three, 3), "");
+}
+
+// A heartbeat and a VO command come back whole.
+TEST(Codec, HeartbeatAndCommandRoundTrip) {
+  const Heartbeat beat{1'700'000'000'000'000, "ppa", 4242, 7, "812 frames"};
+  const Heartbeat back = decode<Heartbeat>(encode(beat));
+  EXPECT_EQ(back.node, "ppa");
+  EXPECT_EQ(back.pid, 4242);
+  EXPECT_EQ(back.sequence, 7);
+  EXPECT_EQ(back.summary, "812 frames");
+
+  VoCommand command;
+  command.utime = 5;
+  command.target = "vo_feature";
+  command.initial_pose = makePose(5, 2.0);
+  const VoCommand command_back = decode<VoCommand>(encode(command));
+  EXPECT_EQ(command_back.target, "vo_feature");
+  ASSERT_TRUE(command_back.initial_pose.has_value());
+  EXPECT_EQ(command_back.initial_pose->p_ned_m, command.initial_pose->p_ned_m);
+  EXPECT_FALSE(decode<VoCommand>(encode(VoCommand{})).initial_pose.has_value());
+}
+
+}  // namespace
+}  // namespace nadir::msg
