@@ -78,9 +78,10 @@ int main(int argc, char** argv) {
     if (out_dir.empty()) out_dir = (run / "bench").string();
     fs::create_directories(out_dir);
 
-    nadir::scenario::ScenarioParams scenario =
-        nadir::scenario::loadScenario(scenario_path.string(), overrides);
-    nadir::vo::VoFeatureNodeParams params = scenario.vo_feature;
+    nadir::nodes::ScenarioParams scenario =
+        nadir::nodes::loadScenario(scenario_path.string(), overrides);
+    nadir::vo::VoFeatureNodeParams params =
+        scenario.node<nadir::vo::VoFeatureNodeParams>(nadir::vo::kFeatureSourceName);
     params.wall_clock_timing = true;
     nadir::core::BusParams bus_params;
     bus_params.url = "memq://";

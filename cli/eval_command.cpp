@@ -8,9 +8,11 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "core/params.h"
 #include "logs/eval/metrics.h"
 #include "logs/eval/run_metrics.h"
 #include "logs/eval/trajectory.h"
+#include "nodes/sim/sim_params.h"
 
 namespace nadir::cli {
 namespace {
@@ -19,10 +21,23 @@ namespace fs = std::filesystem;
 
 struct EvalCommandOptions {
   std::string path;  // RUN_DIR or LOG
+  std::string truth_channel;
   std::string ref;
   std::string est;
   eval::EvalOptions eval;
 };
+
+// The truth's channel: as given, else the run's scenario.yaml's, else (empty) the
+// channel of the log that carries pose_t.
+std::string truthChannelOf(const EvalCommandOptions& options, const fs::path& dir) {
+  if (!options.truth_channel.empty()) return options.truth_channel;
+  const fs::path scenario = dir / "scenario.yaml";
+  if (!fs::is_regular_file(scenario)) return {};
+  sim::SimParams sim;
+  core::applyYamlFileKeys(scenario.string(), {"truth"},
+                          [&sim](core::ParamVisitor& v) { sim.visit(v); });
+  return sim.truth.channel;
+}
 
 void evaluateRun(const EvalCommandOptions& options) {
   fs::path log = options.path;
@@ -30,7 +45,8 @@ void evaluateRun(const EvalCommandOptions& options) {
   if (!fs::exists(log)) throw eval::EvalError(log.string() + ": no such file or directory");
   const fs::path dir = log.has_parent_path() ? log.parent_path() : fs::path(".");
 
-  const eval::RunEvaluation run = eval::evaluateRunLog(log.string(), dir.string(), options.eval);
+  const eval::RunEvaluation run =
+      eval::evaluateRunLog(log.string(), dir.string(), options.eval, truthChannelOf(options, dir));
   if (!run.recorded.damage.empty()) {
     std::cerr << "nadir eval: warning: " << log.string() << ": " << run.recorded.damage << "\n";
   }
@@ -65,6 +81,9 @@ void addEvalCommand(CLI::App& app) {
       "Evaluate a run (RUN_DIR or its LOG: metrics.json, TUM files and a results table), or "
       "compare two TUM trajectories (--ref, --est) with evo's APE and RPE");
   command->add_option("path", options->path, "run folder (holding run.lcmlog) or LCM log");
+  command->add_option("--truth-channel", options->truth_channel,
+                      "the truth's pose_t channel (default: the run's scenario.yaml says, else "
+                      "the log's channel of pose_t)");
   command->add_option("--ref", options->ref, "reference TUM trajectory (with --est)");
   command->add_option("--est", options->est, "estimated TUM trajectory (with --ref)");
   command

@@ -90,6 +90,8 @@ void BusParams::visit(ParamVisitor& v) {
                   "is dropped (udpm, memq)",
            .min = 1,
            .max = 1000000});
+  v.field("heartbeat_channel", &heartbeat_channel,
+          {.doc = "where each live node says, once a second, that it is up (heartbeat_t)"});
 }
 
 std::string BusParams::resolvedUrl() const {

@@ -122,6 +122,8 @@ struct BusParams {
   // camera loses poses at 400 Hz with while it renders a frame.
   int queue_capacity = kDefaultQueueCapacity;
   static constexpr int kDefaultQueueCapacity = 1000;
+  // Live node programs publish heartbeat_t here (nadir launch listens).
+  std::string heartbeat_channel = "NADIR_HEARTBEAT";
 
   void visit(ParamVisitor& v);
   // url with defaults applied and, for udpm://, recv_buf_size added when set here.

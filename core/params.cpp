@@ -345,18 +345,32 @@ class Formatter final : public ParamVisitor {
   int indent_;
 };
 
-}  // namespace
-
-void applyYamlFile(const std::string& path, const VisitParams& visit) {
-  YAML::Node root;
+YAML::Node loadYamlFile(const std::string& path) {
   try {
-    root = YAML::LoadFile(path);
+    return YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw ParamError(path + ": cannot open parameter file");
   } catch (const YAML::ParserException& e) {
     throw ParamError(path + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
   }
-  applyRoot(root, path, true, visit);
+}
+
+}  // namespace
+
+void applyYamlFile(const std::string& path, const VisitParams& visit) {
+  applyRoot(loadYamlFile(path), path, true, visit);
+}
+
+void applyYamlFileKeys(const std::string& path, const std::vector<std::string>& keys,
+                       const VisitParams& visit) {
+  const YAML::Node root = loadYamlFile(path);
+  if (!root || root.IsNull()) return;
+  if (!root.IsMap()) throw ParamError(path + ": expected a map of parameters at the top level");
+  YAML::Node part(YAML::NodeType::Map);
+  for (const std::string& key : keys) {
+    if (root[key]) part[key] = root[key];
+  }
+  applyRoot(part, path, true, visit);
 }
 
 void applyYamlText(std::string_view yaml, std::string_view source, const VisitParams& visit) {

@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -99,6 +100,10 @@ void visitGroupMap(ParamVisitor& visitor, std::string_view key, std::string_view
 
 // Applies a YAML map to the fields. source names the file in errors.
 void applyYamlFile(const std::string& path, const VisitParams& visit);
+// Applies only the top-level keys named (others in the file are left alone): the
+// part of a larger file that a program needs, such as a scenario's world.
+void applyYamlFileKeys(const std::string& path, const std::vector<std::string>& keys,
+                       const VisitParams& visit);
 void applyYamlText(std::string_view yaml, std::string_view source, const VisitParams& visit);
 // Applies "dotted.key=value" (value in YAML syntax: 3, true, [1, 2], text).
 void applyAssignment(std::string_view assignment, std::string_view source,
@@ -127,5 +132,48 @@ template <class P>
 std::string formatParamsOf(P& params) {
   return formatParams([&params](ParamVisitor& v) { params.visit(v); });
 }
+
+// A params struct of any type (one with visit()), held by value: what the node
+// registry passes around for each node without knowing its type.
+class AnyParams {
+ public:
+  template <class P>
+  explicit AnyParams(P params) : self_(std::make_unique<Model<P>>(std::move(params))) {}
+  AnyParams(const AnyParams& other) : self_(other.self_->clone()) {}
+  AnyParams& operator=(const AnyParams& other) {
+    if (this != &other) self_ = other.self_->clone();
+    return *this;
+  }
+  AnyParams(AnyParams&&) noexcept = default;
+  AnyParams& operator=(AnyParams&&) noexcept = default;
+
+  void visit(ParamVisitor& v) { self_->visit(v); }
+  // The struct as its type; throws std::logic_error for another type.
+  template <class P>
+  P& as() {
+    auto* model = dynamic_cast<Model<P>*>(self_.get());
+    if (model == nullptr) throw std::logic_error("AnyParams: not the type asked for");
+    return model->value;
+  }
+  template <class P>
+  const P& as() const {
+    return const_cast<AnyParams*>(this)->as<P>();
+  }
+
+ private:
+  struct Concept {
+    virtual ~Concept() = default;
+    virtual std::unique_ptr<Concept> clone() const = 0;
+    virtual void visit(ParamVisitor& v) = 0;
+  };
+  template <class P>
+  struct Model final : Concept {
+    explicit Model(P p) : value(std::move(p)) {}
+    std::unique_ptr<Concept> clone() const override { return std::make_unique<Model>(value); }
+    void visit(ParamVisitor& v) override { value.visit(v); }
+    P value;
+  };
+  std::unique_ptr<Concept> self_;
+};
 
 }  // namespace nadir::core

@@ -14,11 +14,13 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <limits>
+#include <map>
 
 #include "core/params.h"
 #include "gui/plots.h"
-#include "nodes/scenario.h"
+#include "nodes/scenario_files.h"
 
 namespace nadir::gui {
 namespace {
@@ -159,8 +161,36 @@ QColor truthColor(std::size_t run_index) {
   return kReds[run_index % kReds.size()];
 }
 
+namespace {
+
+// The parts of a scenario the viewer draws; the rest of the file is not read.
+struct ScenarioTerrain {
+  terrain::WorldParams world;
+  terrain::TileParams tiles;
+  render::TerrainRendererParams renderer;
+  std::map<std::string, terrain::GroundTarget> targets;
+
+  void visit(core::ParamVisitor& v) {
+    core::visitGroup(v, "world", "the terrain", world);
+    core::visitGroup(v, "tiles", "terrain tiles", tiles);
+    core::visitGroup(v, "renderer", "terrain drawing", renderer);
+    core::visitGroupMap(v, "targets", "ground targets", targets);
+  }
+};
+
+ScenarioTerrain readScenarioTerrain(const std::string& name_or_path) {
+  const std::string path = nodes::resolveScenarioPath(name_or_path);
+  ScenarioTerrain params;
+  core::applyYamlFileKeys(path, {"world", "tiles", "renderer", "targets"},
+                          [&params](core::ParamVisitor& v) { params.visit(v); });
+  terrain::resolvePathsFrom(params.world, std::filesystem::path(path).parent_path().string());
+  return params;
+}
+
+}  // namespace
+
 ViewerTerrain terrainOfScenario(const std::string& scenario_yaml) {
-  scenario::ScenarioParams params = scenario::loadScenario(scenario_yaml);
+  ScenarioTerrain params = readScenarioTerrain(scenario_yaml);
   ViewerTerrain terrain;
   terrain.built = terrain::makeWorld(params.world);
   terrain.tiles = std::make_shared<terrain::TileTree>(terrain.built.world, params.tiles);
@@ -173,7 +203,7 @@ ViewerTerrain terrainOfScenario(const std::string& scenario_yaml) {
 }
 
 std::string worldOfScenario(const std::string& scenario_yaml) {
-  scenario::ScenarioParams params = scenario::loadScenario(scenario_yaml);
+  ScenarioTerrain params = readScenarioTerrain(scenario_yaml);
   return core::formatParamsOf(params.world);
 }
 

@@ -39,8 +39,9 @@ struct ViewerTerrain {
   std::string world;          // its world as worldOfScenario gives it
 };
 
-// Builds the terrain of a run's scenario.yaml (throws what loadScenario and
-// makeWorld throw, naming the file or what is wrong).
+// Builds the terrain of a scenario (a run's scenario.yaml, a file or a built-in
+// name) from its world, tiles, renderer and targets; throws core::ParamError
+// naming the file and key, or what makeWorld throws.
 ViewerTerrain terrainOfScenario(const std::string& scenario_yaml);
 
 // The world a scenario flies over (its world parameters: kind, seed, files,

@@ -1,45 +1,139 @@
 #include "nodes/node_main.h"
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
+#include <memory>
 
-namespace nadir::scenario {
+#include "core/clock.h"
+#include "lcmtypes/bus_io.h"
+#include "nodes/registry.h"
+#include "nodes/scenario.h"
+
+namespace nadir::nodes {
 namespace {
 
 std::atomic<bool> g_stop{false};
 
 void onSignal(int) { g_stop = true; }
 
+// A --config file: the bus, then the node's own keys at the top level.
+struct ProcessParams {
+  core::BusParams bus;
+  core::AnyParams node;
+
+  void visit(core::ParamVisitor& v) {
+    core::visitGroup(v, "bus", "where messages come from and go", bus);
+    node.visit(v);
+  }
+};
+
+void listScenarios() {
+  for (const std::string& name : builtinScenarioNames()) {
+    std::string description;
+    try {
+      description = loadScenario(name).description;
+    } catch (const std::exception& error) {
+      description = std::string("(does not load: ") + error.what() + ")";
+    }
+    std::printf("%-20s %s\n", name.c_str(), description.c_str());
+  }
+}
+
+// Sends the node's heartbeat now and then once a second of wall time.
+class Heartbeat {
+ public:
+  Heartbeat(core::Bus& bus, std::string channel, std::string node)
+      : bus_(bus), channel_(std::move(channel)), node_(std::move(node)) {}
+
+  void beatIfDue(const Node& running) {
+    const auto now = std::chrono::steady_clock::now();
+    if (sequence_ > 0 && now - last_ < std::chrono::seconds(1)) return;
+    last_ = now;
+    msg::publish(
+        bus_, channel_,
+        msg::Heartbeat{core::wallClockUtime(), node_, static_cast<std::int32_t>(::getpid()),
+                       sequence_++, running.summary()});
+  }
+
+ private:
+  core::Bus& bus_;
+  std::string channel_;
+  std::string node_;
+  std::int64_t sequence_ = 0;
+  std::chrono::steady_clock::time_point last_;
+};
+
 }  // namespace
 
-int runScenarioNode(int argc, char** argv, const ScenarioNodeSpec& spec) {
-  CLI::App app{spec.program + ": " + spec.description};
-  std::string scenario_name = spec.default_scenario;
+int runNodeMain(int argc, char** argv, const char* node_name) {
+  const Entry& node_entry = entry(node_name);
+  const EntryInfo& info = node_entry.info();
+  CLI::App app{info.program + ": " + info.description};
+  std::string scenario_name = info.default_scenario;
+  std::string config_path;
   std::vector<std::string> overrides;
-  app.add_option("scenario", scenario_name, "built-in scenario name or YAML file")
-      ->capture_default_str();
-  app.add_option("--set", overrides, "override a parameter: key=value (repeatable)");
+  bool list = false;
+  auto* scenario_option =
+      app.add_option("scenario,--scenario", scenario_name, "built-in scenario name or YAML file")
+          ->capture_default_str();
+  app.add_option("--config", config_path,
+                 "the node's own parameters (YAML: its keys, and bus) instead of a scenario")
+      ->check(CLI::ExistingFile)
+      ->excludes(scenario_option);
+  app.add_option("--set", overrides,
+                 "override a parameter: key=value (repeatable; keys of the scenario, or of "
+                 "the --config file)");
+  app.add_flag("--list", list, "list the built-in scenarios and exit");
   CLI11_PARSE(app, argc, argv);
+  if (list) {
+    listScenarios();
+    return 0;
+  }
 
   try {
-    ScenarioParams scenario = loadScenario(scenario_name, overrides);
-    std::cout << spec.program << " parameters (" << scenario_name << "):\n"
-              << spec.format_params(scenario) << std::flush;
-    auto bus = core::openBus(scenario.bus);
-    const std::function<std::string()> summary = spec.start(*bus, scenario);
+    ProcessParams params{{}, node_entry.defaultParams()};
+    std::string source;
+    if (!config_path.empty()) {
+      core::applyYamlFile(config_path, [&params](core::ParamVisitor& v) { params.visit(v); });
+      core::applyAssignments(params, overrides);
+      source = config_path;
+    } else {
+      const ScenarioParams scenario = loadScenario(scenario_name, overrides);
+      params.bus = scenario.bus;
+      params.node = node_entry.fromScenario(scenario);
+      source = scenario_name;
+    }
+    std::cout << info.program << " parameters (" << source << "):\n"
+              << core::formatParamsOf(params.node) << std::flush;
+
+    auto bus = core::openBus(params.bus);
+    const std::unique_ptr<Node> node = node_entry.start(*bus, params.node);
+    if (const std::string about = node->describe(); !about.empty()) std::cout << about << "\n";
     std::cout << "bus: " << bus->url() << std::endl;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    while (!g_stop) bus->handle(std::chrono::milliseconds(100));
-    std::cout << spec.program << ": " << summary() << std::endl;
+    // Not into a log file: its events are in message time, a heartbeat's is wall time.
+    const bool live = bus->url().rfind("file://", 0) != 0;
+    Heartbeat heartbeat(*bus, params.bus.heartbeat_channel, info.name);
+    bool working = true;
+    while (!g_stop && working) {
+      if (live) heartbeat.beatIfDue(*node);
+      working = node->turn(*bus);
+    }
+    std::cout << info.program << ": " << (g_stop ? "stopped" : "done") << "; " << node->summary()
+              << std::endl;
   } catch (const std::exception& error) {
-    std::cerr << spec.program << ": error: " << error.what() << std::endl;
+    std::cerr << info.program << ": error: " << error.what() << std::endl;
     return 1;
   }
   return 0;
 }
 
-}  // namespace nadir::scenario
+}  // namespace nadir::nodes

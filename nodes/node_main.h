@@ -1,29 +1,19 @@
 #pragma once
-// The main() of a node that takes its parameters from a scenario (nadir-ppa,
-// nadir-vo-feature): `PROGRAM [SCENARIO] [--set key=value ...]`. It loads the
-// scenario, prints the node's parameters, opens the scenario's bus, starts the
-// node, handles messages until SIGINT or SIGTERM, and prints the node's summary.
+// The one main() of every node program (nadir-sim, nadir-camera, nadir-ppa,
+// nadir-vo-feature, ...):
+//
+//   PROGRAM [SCENARIO] [--set key=value ...]    the node's part of a scenario
+//   PROGRAM --config FILE [--set key=value ...]  the node's own parameters
+//   PROGRAM --list                               the built-in scenarios
+//
+// It prints the node's effective parameters, opens the bus, builds the node
+// from its registry entry, publishes a heartbeat_t when the node is ready and
+// then once a second (nadir launch waits for the first), runs the node until it
+// is done or SIGINT/SIGTERM, and prints what the node did.
 
-#include <functional>
-#include <memory>
-#include <string>
+namespace nadir::nodes {
 
-#include "core/bus.h"
-#include "nodes/scenario.h"
+// Returns the process's exit status: 0, or 1 with the error on stderr.
+int runNodeMain(int argc, char** argv, const char* node_name);
 
-namespace nadir::scenario {
-
-struct ScenarioNodeSpec {
-  std::string program;      // e.g. "nadir-ppa"
-  std::string description;  // one line for --help
-  std::string default_scenario;
-  // The node's parameter group as text, printed at start.
-  std::function<std::string(ScenarioParams&)> format_params;
-  // Builds the node on the bus (kept alive until the end) and returns what to
-  // print when it stops; says "bus: ..." once it listens (nadir launch waits for that).
-  std::function<std::function<std::string()>(core::Bus&, const ScenarioParams&)> start;
-};
-
-int runScenarioNode(int argc, char** argv, const ScenarioNodeSpec& spec);
-
-}  // namespace nadir::scenario
+}  // namespace nadir::nodes

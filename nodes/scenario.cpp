@@ -1,10 +1,14 @@
 #include "nodes/scenario.h"
 
+#include "nodes/registry.h"
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
 
-namespace nadir::scenario {
+namespace nadir::nodes {
 namespace {
 
 namespace fs = std::filesystem;
@@ -17,11 +21,19 @@ void resolveRelative(std::string& path, const fs::path& folder) {
 
 }  // namespace
 
-void TimeParams::visit(core::ParamVisitor& v) {
-  v.field("mode", &mode,
-          {.doc = "realtime (paced at speed x real time) or batch (as fast as possible)",
-           .choices = {"realtime", "batch"}});
-  v.field("speed", &speed, {.doc = "realtime: multiple of real time", .min = 0.01, .max = 1000});
+ScenarioParams::ScenarioParams() {
+  for (const auto& entry : registry()) {
+    if (std::optional<core::AnyParams> group = entry->scenarioGroup()) {
+      nodes.push_back({entry->info().name, entry->scenarioGroupDoc(), std::move(*group)});
+    }
+  }
+}
+
+NodeGroup& ScenarioParams::group(std::string_view name) {
+  for (NodeGroup& group : nodes) {
+    if (group.name == name) return group;
+  }
+  throw std::logic_error("the scenario has no node group " + std::string(name));
 }
 
 void ScenarioParams::visit(core::ParamVisitor& v) {
@@ -33,8 +45,7 @@ void ScenarioParams::visit(core::ParamVisitor& v) {
   core::visitGroupMap(v, "targets", "ground targets by name", targets);
   core::visitGroup(v, "tiles", "terrain tiles and levels of detail", tiles);
   core::visitGroup(v, "renderer", "terrain drawing", renderer);
-  core::visitGroup(v, "ppa", "the emulated SCAMP-5 vision sensor (nadir-ppa)", ppa);
-  core::visitGroup(v, "vo_feature", "the feature-based VO (nadir-vo-feature)", vo_feature);
+  for (NodeGroup& group : nodes) core::visitGroup(v, group.name, group.doc, group.params);
   core::visitGroup(v, "time", "how sim time runs", time);
   core::visitGroup(v, "bus", "where the streams go", bus);
 }
@@ -43,18 +54,6 @@ std::map<std::string, camera::CameraSpec> ScenarioParams::allCameras() const {
   std::map<std::string, camera::CameraSpec> all = cameras;
   all["down"] = camera;
   return all;
-}
-
-camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario) {
-  camera::CameraNodeParams params;
-  params.bus = scenario.bus;
-  params.pose_channel = scenario.sim.truth.channel;
-  params.world = scenario.world;
-  params.tiles = scenario.tiles;
-  params.renderer = scenario.renderer;
-  params.cameras = scenario.allCameras();
-  params.targets = scenario.targets;
-  return params;
 }
 
 core::Geodetic scenarioOrigin(const ScenarioParams& scenario) {
@@ -79,51 +78,16 @@ std::vector<Eigen::Vector2d> knownTargets(const ScenarioParams& scenario,
   return positions;
 }
 
-std::string scenarioDirectory() {
-  if (const char* dir = std::getenv("NADIR_SCENARIO_DIR"); dir != nullptr && *dir != '\0') {
-    return dir;
-  }
-  return NADIR_SOURCE_SCENARIO_DIR;
-}
-
-std::vector<std::string> builtinScenarioNames() {
-  std::vector<std::string> names;
-  std::error_code error;
-  for (const auto& entry : fs::directory_iterator(scenarioDirectory(), error)) {
-    if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-std::string resolveScenarioPath(const std::string& name_or_path) {
-  if (fs::is_regular_file(name_or_path)) return name_or_path;
-  const fs::path builtin = fs::path(scenarioDirectory()) / (name_or_path + ".yaml");
-  if (name_or_path.find('/') == std::string::npos && fs::is_regular_file(builtin)) {
-    return builtin.string();
-  }
-  std::string names;
-  for (const std::string& name : builtinScenarioNames()) {
-    names += (names.empty() ? "" : ", ") + name;
-  }
-  throw core::ParamError("scenario '" + name_or_path +
-                         "': no such file and no built-in scenario of that name (built in: " +
-                         (names.empty() ? "none found in " + scenarioDirectory() : names) + ")");
-}
-
 ScenarioParams loadScenario(const std::string& name_or_path,
                             const std::vector<std::string>& overrides) {
   const std::string path = resolveScenarioPath(name_or_path);
   ScenarioParams params;
   core::applyYamlFile(path, [&params](core::ParamVisitor& v) { params.visit(v); });
   const fs::path folder = fs::path(path).parent_path();
-  for (std::string* file : {&params.world.dem_path, &params.world.imagery_path,
-                            &params.world.imagery_red_path, &params.world.imagery_green_path,
-                            &params.world.imagery_blue_path, &params.sim.flight.path}) {
-    resolveRelative(*file, folder);
-  }
+  terrain::resolvePathsFrom(params.world, folder.string());
+  resolveRelative(params.sim.flight.path, folder);
   core::applyAssignments(params, overrides);
   return params;
 }
 
-}  // namespace nadir::scenario
+}  // namespace nadir::nodes

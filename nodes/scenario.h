@@ -1,40 +1,43 @@
 #pragma once
-// A scenario: everything one experiment needs, in one YAML file: the world
-// and its origin, the vehicle and its route (or a recorded flight), the truth
-// stream, the sensors, the cameras, the ground targets, how time runs and the
-// bus. Built-in scenarios live in scenarios/*.yaml; any value can be
-// overridden with "key=value" (the experiment axes: vehicle.airspeed_mps,
+// A scenario: everything one experiment needs, in one YAML file: the world and
+// its origin, the vehicle and its route (or a recorded flight), the truth
+// stream, the sensors, the cameras, the ground targets, how time runs, the bus,
+// and a group for each processing node of the registry (ppa, vo_feature, ...).
+// Built-in scenarios live in scenarios/*.yaml; any value can be overridden with
+// "key=value" (the experiment axes: vehicle.airspeed_mps,
 // vehicle.max_roll_rate_dps, vehicle.altitude_agl_m, camera.fps).
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "core/bus.h"
+#include "core/geodesy.h"
 #include "core/params.h"
-#include "nodes/camera/camera_node_params.h"
 #include "nodes/camera/camera_rig.h"
-#include "nodes/ppa/ppa_node_params.h"
+#include "nodes/scenario_files.h"
 #include "nodes/sim/sim_params.h"
-#include "nodes/vo_feature/vo_feature_node.h"
 #include "render/terrain_renderer.h"
 #include "terrain/targets.h"
 #include "terrain/tiles.h"
 #include "terrain/world_factory.h"
 
-namespace nadir::scenario {
+namespace nadir::nodes {
 
-struct TimeParams {
-  // "realtime" paces the streams at speed x real time; "batch" runs as fast as possible.
-  std::string mode = "realtime";
-  double speed = 1.0;
-
-  void visit(core::ParamVisitor& v);
+// A processing node's group in a scenario.
+struct NodeGroup {
+  std::string name;
+  std::string doc;
+  core::AnyParams params;
 };
 
 struct ScenarioParams {
+  // Every registry entry's group with its defaults.
+  ScenarioParams();
+
   // One line saying what the scenario flies.
   std::string description;
   // Vehicle, start, route, flight, truth, sensors and duration_s, at the top level.
@@ -46,20 +49,29 @@ struct ScenarioParams {
   std::map<std::string, terrain::GroundTarget> targets;
   terrain::TileParams tiles;
   render::TerrainRendererParams renderer;
-  // The VO nodes: the emulated SCAMP-5 vision sensor and the feature-based VO.
-  ppa::PpaNodeParams ppa;
-  vo::VoFeatureNodeParams vo_feature;
-  TimeParams time;
+  // The processing nodes, in registry order.
+  std::vector<NodeGroup> nodes;
+  sim::TimeParams time;
   core::BusParams bus;
 
   void visit(core::ParamVisitor& v);
   // The main camera as "down" and the others under their names.
   std::map<std::string, camera::CameraSpec> allCameras() const;
-};
 
-// What the camera node needs from a scenario: its bus, the truth channel,
-// the world, tiles, renderer, cameras and targets.
-camera::CameraNodeParams cameraNodeParams(const ScenarioParams& scenario);
+  // A node's group as its params type; throws std::logic_error for a name or a
+  // type the scenario does not have.
+  template <class P>
+  P& node(std::string_view name) {
+    return group(name).params.as<P>();
+  }
+  template <class P>
+  const P& node(std::string_view name) const {
+    return const_cast<ScenarioParams*>(this)->group(name).params.as<P>();
+  }
+
+ private:
+  NodeGroup& group(std::string_view name);
+};
 
 // The world frame's geodetic origin (reads the DEM only when the origin is its centre).
 core::Geodetic scenarioOrigin(const ScenarioParams& scenario);
@@ -69,15 +81,6 @@ core::Geodetic scenarioOrigin(const ScenarioParams& scenario);
 std::vector<Eigen::Vector2d> knownTargets(const ScenarioParams& scenario,
                                           const core::LocalNedFrame& frame);
 
-// The folder of the built-in scenarios: $NADIR_SCENARIO_DIR if set, else the
-// project's scenarios/ folder.
-std::string scenarioDirectory();
-// Names of the built-in scenarios, sorted.
-std::vector<std::string> builtinScenarioNames();
-// A path to an existing file as given, else the built-in NAME; throws
-// core::ParamError listing the built-in names if neither exists.
-std::string resolveScenarioPath(const std::string& name_or_path);
-
 // Loads a scenario (a built-in name or a YAML path) and applies the overrides
 // ("key=value"); file paths in it are relative to its folder. Throws
 // core::ParamError naming the file, line and key of an unknown key, a wrong
@@ -86,4 +89,4 @@ std::string resolveScenarioPath(const std::string& name_or_path);
 ScenarioParams loadScenario(const std::string& name_or_path,
                             const std::vector<std::string>& overrides = {});
 
-}  // namespace nadir::scenario
+}  // namespace nadir::nodes

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -17,6 +18,8 @@
 #include "core/bus.h"
 #include "core/clock.h"
 #include "lcmtypes/codec.h"
+#include "lcmtypes/messages.h"
+#include "nodes/registry.h"
 #include "nodes/scenario.h"
 #include "nodes/sim/simulator.h"
 #include "run/process.h"
@@ -28,13 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-bool fileContains(const std::string& path, const std::string& text) {
-  std::ifstream in(path);
-  std::stringstream content;
-  content << in.rdbuf();
-  return content.str().find(text) != std::string::npos;
-}
 
 std::string programPath(const std::string& bin_dir, const std::string& name) {
   const fs::path path = fs::path(bin_dir) / name;
@@ -60,10 +56,43 @@ struct ChannelHealth {
   }
 };
 
+struct LaunchedNode {
+  const nodes::Entry* entry = nullptr;
+  std::unique_ptr<ChildProcess> process;
+};
+
+// Every channel's rate in the last window against what the scenario should
+// produce, the VO nodes' status, and what each node's heartbeat says.
+void printHealth(std::ostream& out, double elapsed_s, double window_s, double speed,
+                 std::map<std::string, ChannelHealth>& channels,
+                 const std::map<std::string, std::string>& heartbeats) {
+  char line[256];
+  std::snprintf(line, sizeof(line), "launch: %.0f s", elapsed_s);
+  out << line << "\n";
+  for (auto& [name, health] : channels) {
+    std::snprintf(line, sizeof(line), "  %-18s %8.1f Hz", name.c_str(),
+                  static_cast<double>(health.window) / window_s);
+    out << line;
+    if (health.expected_hz > 0.0) {
+      std::snprintf(line, sizeof(line), " (expected %.1f), %lld missing",
+                    health.expected_hz * speed, static_cast<long long>(health.missing()));
+      out << line;
+    }
+    if (health.vo_status >= 0) {
+      static const char* kStatus[] = {"INITIALIZING", "TRACKING", "LOST"};
+      out << " " << (health.vo_status <= 2 ? kStatus[health.vo_status] : "?");
+    }
+    out << "\n";
+    health.window = 0;
+  }
+  for (const auto& [node, summary] : heartbeats) out << "  " << node << ": " << summary << "\n";
+  out.flush();
+}
+
 }  // namespace
 
 int launchScenario(const LaunchOptions& options, std::ostream& out, const std::atomic<bool>& stop) {
-  scenario::ScenarioParams scenario = scenario::loadScenario(options.scenario, options.overrides);
+  nodes::ScenarioParams scenario = nodes::loadScenario(options.scenario, options.overrides);
   {
     // Refuse what nadir-sim would refuse before any process starts.
     const terrain::BuiltWorld built = terrain::makeWorld(scenario.world);
@@ -89,50 +118,54 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   writeEffectiveScenario(out_dir, "nadir launch " + options.scenario, scenario);
   const std::string bin_dir = options.bin_dir.empty() ? selfDirectory() : options.bin_dir;
   const std::string url = scenario.bus.resolvedUrl();
-
-  std::vector<std::string> scenario_args = {options.scenario};
-  for (const std::string& assignment : options.overrides) {
-    scenario_args.push_back("--set");
-    scenario_args.push_back(assignment);
-  }
   const auto nodeLog = [&](const std::string& name) {
     return (out_path / (name + ".log")).string();
   };
-  const auto withScenario = [&scenario_args](std::vector<std::string> argv) {
-    argv.insert(argv.end(), scenario_args.begin(), scenario_args.end());
-    return argv;
-  };
+
+  // One process per node the scenario runs, each given the scenario and overrides;
+  // the simulator starts once the others are up, and the health report expects
+  // what the nodes' streams say.
   ChildProcess logger("lcm-logger", {"lcm-logger", "--lcm-url=" + url, "-f", recording.string()},
                       nodeLog("lcm-logger"));
-  ChildProcess camera("nadir-camera",
-                      withScenario({programPath(bin_dir, "nadir-camera"), "--scenario"}),
-                      nodeLog("camera"));
-  ChildProcess simulator("nadir-sim", withScenario({programPath(bin_dir, "nadir-sim")}),
-                         nodeLog("sim"));
-  // The VO nodes the scenario names.
-  ChildProcess ppa("nadir-ppa",
-                   withScenario({scenario.ppa.enabled ? programPath(bin_dir, "nadir-ppa")
-                                                      : std::string("nadir-ppa")}),
-                   nodeLog("ppa"));
-  ChildProcess vo_feature(
-      "nadir-vo-feature",
-      withScenario({scenario.vo_feature.enabled ? programPath(bin_dir, "nadir-vo-feature")
-                                                : std::string("nadir-vo-feature")}),
-      nodeLog("vo_feature"));
-  std::vector<ChildProcess*> listeners = {&camera};
-  if (scenario.ppa.enabled) listeners.push_back(&ppa);
-  if (scenario.vo_feature.enabled) listeners.push_back(&vo_feature);
-  std::vector<ChildProcess*> nodes = {&logger};
-  nodes.insert(nodes.end(), listeners.begin(), listeners.end());
-  nodes.push_back(&simulator);
-
-  // Health: what arrives on the bus, against what the scenario should produce.
-  auto bus = core::openBus(scenario.bus);
+  std::vector<LaunchedNode> launched;
   std::map<std::string, ChannelHealth> channels;
-  channels[scenario.sim.truth.channel].expected_hz = scenario.sim.truth.rate_hz;
-  for (const auto& [name, spec] : scenario.allCameras())
-    channels[spec.channel].expected_hz = spec.fps;
+  for (const auto& entry : nodes::registry()) {
+    if (!entry->enabled(scenario)) continue;
+    std::vector<std::string> argv = {programPath(bin_dir, entry->info().program), options.scenario};
+    for (const std::string& assignment : options.overrides) {
+      argv.push_back("--set");
+      argv.push_back(assignment);
+    }
+    launched.push_back({entry.get(), std::make_unique<ChildProcess>(entry->info().program, argv,
+                                                                    nodeLog(entry->info().name))});
+    for (const nodes::Stream& stream : entry->streams(entry->fromScenario(scenario))) {
+      if (stream.rate_hz > 0.0) channels[stream.channel].expected_hz = stream.rate_hz;
+    }
+  }
+  const auto isSimulator = [](const LaunchedNode& node) {
+    return node.entry->info().role == nodes::EntryInfo::Role::kSimulator;
+  };
+  std::vector<ChildProcess*> processes = {&logger};
+  for (LaunchedNode& node : launched) processes.push_back(node.process.get());
+  ChildProcess* simulator = nullptr;
+  for (LaunchedNode& node : launched) {
+    if (isSimulator(node)) simulator = node.process.get();
+  }
+  if (simulator == nullptr) throw std::logic_error("the registry has no simulator");
+
+  // Health: what arrives on the bus, against what the scenario should produce;
+  // the nodes' heartbeats say they are up and what they have done.
+  auto bus = core::openBus(scenario.bus);
+  std::map<std::string, std::string> heartbeats;  // node name -> its last summary
   auto subscription = bus->subscribe(".*", [&](const core::RawMessage& raw) {
+    if (raw.channel == scenario.bus.heartbeat_channel) {
+      try {
+        const msg::Heartbeat beat = msg::decode<msg::Heartbeat>(raw.data, raw.size);
+        heartbeats[beat.node] = beat.summary;
+      } catch (const std::exception&) {
+      }
+      return;
+    }
     ChannelHealth& health = channels[std::string(raw.channel)];
     ++health.total;
     ++health.window;
@@ -153,7 +186,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       << out_dir << "\n";
   int result = 0;
   const auto stopAll = [&] {
-    for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) (*it)->stop(5.0);
+    for (auto it = processes.rbegin(); it != processes.rend(); ++it) (*it)->stop(5.0);
   };
   const auto failed = [&](const ChildProcess& node) {
     out << "launch: " << node.name() << " died (" << node.describeExit() << "); see "
@@ -162,27 +195,31 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   };
   try {
     logger.start();
-    for (ChildProcess* node : listeners) node->start();
-    // Each node sets up (the camera its world and GL context) before it listens
-    // and says "bus: ..."; the simulator starts when all have.
+    for (LaunchedNode& node : launched) {
+      if (!isSimulator(node)) node.process->start();
+    }
+    // Each node sets up (the camera its world and GL context) before its first
+    // heartbeat; the simulator starts when all have sent one.
     const auto ready_deadline = Clock::now() + std::chrono::seconds(120);
-    for (ChildProcess* node : listeners) {
-      while (!fileContains(node->logPath(), "bus: ")) {
-        if (!node->running()) {
-          failed(*node);
+    for (LaunchedNode& node : launched) {
+      if (isSimulator(node)) continue;
+      while (heartbeats.count(node.entry->info().name) == 0) {
+        if (!node.process->running()) {
+          failed(*node.process);
           stopAll();
           return result;
         }
         if (stop || Clock::now() > ready_deadline) {
-          out << "launch: " << (stop ? "stopped" : node->name() + " not ready after 120 s") << "\n";
+          out << "launch: "
+              << (stop ? "stopped" : node.process->name() + " not up after 120 s (no heartbeat)")
+              << "\n";
           stopAll();
           return stop ? 130 : 1;
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        bus->handle(std::chrono::milliseconds(100));
       }
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    simulator.start();
+    simulator->start();
     out << "launch: nadir-sim started; Ctrl-C stops every node\n";
 
     const auto started = Clock::now();
@@ -195,9 +232,9 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         result = 130;
         break;
       }
-      if (!simulator.running()) {
-        if (simulator.exitStatus() != 0) {
-          failed(simulator);
+      if (!simulator->running()) {
+        if (simulator->exitStatus() != 0) {
+          failed(*simulator);
           stopAll();
           break;
         }
@@ -209,8 +246,8 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         break;
       }
       bool node_died = false;
-      for (ChildProcess* node : nodes) {
-        if (node != &simulator && !node->running()) {
+      for (ChildProcess* node : processes) {
+        if (node != simulator && !node->running()) {
           failed(*node);
           node_died = true;
         }
@@ -223,28 +260,8 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       const double window_s = std::chrono::duration<double>(now - last_report).count();
       if (window_s >= options.report_period_s) {
         last_report = now;
-        char line[256];
-        std::snprintf(line, sizeof(line), "launch: %.0f s",
-                      std::chrono::duration<double>(now - started).count());
-        out << line << "\n";
-        for (auto& [name, health] : channels) {
-          std::snprintf(line, sizeof(line), "  %-18s %8.1f Hz", name.c_str(),
-                        static_cast<double>(health.window) / window_s);
-          out << line;
-          if (health.expected_hz > 0.0) {
-            std::snprintf(line, sizeof(line), " (expected %.1f), %lld missing",
-                          health.expected_hz * scenario.time.speed,
-                          static_cast<long long>(health.missing()));
-            out << line;
-          }
-          if (health.vo_status >= 0) {
-            static const char* kStatus[] = {"INITIALIZING", "TRACKING", "LOST"};
-            out << " " << (health.vo_status <= 2 ? kStatus[health.vo_status] : "?");
-          }
-          out << "\n";
-          health.window = 0;
-        }
-        out.flush();
+        printHealth(out, std::chrono::duration<double>(now - started).count(), window_s,
+                    scenario.time.speed, channels, heartbeats);
       }
     }
   } catch (...) {
@@ -252,7 +269,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     throw;
   }
   out << "launch: nodes\n";
-  for (const ChildProcess* node : nodes) {
+  for (const ChildProcess* node : processes) {
     const bool clean =
         node->exitStatus() == 0 || (node->stoppedByUs() && node->exitStatus() != 128 + SIGKILL);
     out << "  " << node->name() << ": " << node->describeExit()

@@ -15,13 +15,11 @@
 #include "core/lcm_log.h"
 #include "lcmtypes/bus_io.h"
 #include "nodes/camera/camera_node.h"
-#include "nodes/ppa/ppa_node.h"
+#include "nodes/registry.h"
 #include "nodes/scenario.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
-#include "nodes/vo_feature/vo_feature_node.h"
 #include "run/process.h"
-#include "run/target_passes.h"
 #include "run/track_plot.h"
 #include "terrain/world.h"
 
@@ -45,13 +43,11 @@ std::string defaultOutDir(const std::string& scenario) {
 
 RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress) {
-  scenario::ScenarioParams scenario = scenario::loadScenario(options.scenario, options.overrides);
+  nodes::ScenarioParams scenario = nodes::loadScenario(options.scenario, options.overrides);
   // Everything stays in this process: the bus is in-process whatever the file says.
   scenario.bus.url = "memq://";
-  // Byte-identical runs: no wall-clock times, the feature VO's local BA at fixed
-  // key-frames. Set here so that scenario.yaml says what ran.
-  scenario.vo_feature.wall_clock_timing = false;
-  scenario.vo_feature.vo.background_ba = false;
+  // Byte-identical runs; set in the scenario so that scenario.yaml says what ran.
+  for (const auto& entry : nodes::registry()) entry->makeDeterministic(scenario);
 
   RunResult result;
   result.out_dir = options.out_dir.empty() ? defaultOutDir(options.scenario) : options.out_dir;
@@ -65,13 +61,25 @@ RunResult runScenario(const RunOptions& options,
   result.metrics_path = (out / kMetricsName).string();
   writeEffectiveScenario(result.out_dir, "nadir run " + options.scenario, scenario);
 
+  // The processing nodes the scenario runs, with their parameters.
+  std::vector<std::pair<const nodes::Entry*, core::AnyParams>> processing;
+  for (const auto& entry : nodes::registry()) {
+    if (entry->info().role == nodes::EntryInfo::Role::kProcessing && entry->enabled(scenario)) {
+      processing.emplace_back(entry.get(), entry->fromScenario(scenario));
+    }
+  }
+
   auto bus = core::openBus(scenario.bus);
   core::LcmLogWriter log(result.log_path);
   // Every message is recorded at its own (sim) time, images unless left out.
   std::set<std::string> unrecorded;
   if (!options.record_images) {
-    for (const auto& [name, spec] : scenario.allCameras()) unrecorded.insert(spec.channel);
-    unrecorded.insert(scenario.vo_feature.debug_channel);
+    for (const auto& entry : nodes::registry()) {
+      if (entry->info().role == nodes::EntryInfo::Role::kSimulator) continue;
+      for (const nodes::Stream& stream : entry->streams(entry->fromScenario(scenario))) {
+        if (stream.bulky) unrecorded.insert(stream.channel);
+      }
+    }
   }
   core::Subscription recorder =
       bus->subscribe(".*", [&log, &result, &unrecorded](const core::RawMessage& raw) {
@@ -81,7 +89,11 @@ RunResult runScenario(const RunOptions& options,
         log.write(core::peekUtime(raw).value_or(0), channel, raw.data, raw.size);
       });
 
-  camera::CameraNode camera(*bus, scenario::cameraNodeParams(scenario));
+  // The simulator and the camera make the world (the camera's world serves both);
+  // the processing nodes come from the registry.
+  const nodes::Entry& camera_entry = nodes::entry("camera");
+  camera::CameraNode camera(*bus,
+                            camera_entry.fromScenario(scenario).as<camera::CameraNodeParams>());
   // The main camera's last image, for a picture of what it saw.
   cv::Mat last_image;
   core::Subscription last_image_keeper = msg::subscribe<msg::Image>(
@@ -91,22 +103,8 @@ RunResult runScenario(const RunOptions& options,
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
-  // The VO nodes the scenario names, on the same bus.
-  std::optional<ppa::PpaNode> ppa_node;
-  std::vector<std::pair<double, bool>> detector_frames;
-  std::vector<core::Subscription> detector_subscription;
-  const std::vector<Eigen::Vector2d> targets_ne_m = scenario::knownTargets(scenario, frame);
-  std::optional<vo::VoFeatureNode> vo_feature_node;
-  if (scenario.vo_feature.enabled) {
-    vo_feature_node.emplace(*bus, scenario.vo_feature);
-  }
-  if (scenario.ppa.enabled) {
-    ppa_node.emplace(*bus, scenario.ppa, targets_ne_m);
-    detector_subscription.push_back(msg::subscribe<msg::TargetDetection>(
-        *bus, scenario.ppa.target_channel, [&detector_frames](const msg::TargetDetection& d) {
-          detector_frames.emplace_back(core::secondsFromUtime(d.utime), d.detected);
-        }));
-  }
+  std::vector<std::unique_ptr<nodes::Node>> running;
+  for (const auto& [entry, params] : processing) running.push_back(entry->start(*bus, params));
 
   const auto wall_start = std::chrono::steady_clock::now();
   auto last_report = wall_start;
@@ -136,39 +134,28 @@ RunResult runScenario(const RunOptions& options,
 
   const eval::RunEvaluation evaluation = eval::evaluateRunLog(
       result.log_path, out.string(), eval::EvalOptions{}, scenario.sim.truth.channel);
-  const logs::LogTrajectories& recorded = evaluation.recorded;
   result.metrics = evaluation.metrics;
   result.metrics_path = evaluation.metrics_path;
   result.tum_paths = evaluation.tum_paths;
   result.picture_paths.push_back((out / "tracks.png").string());
-  writeTrackPlot(result.picture_paths.back(), recorded.truth, evaluation.tracked,
+  writeTrackPlot(result.picture_paths.back(), evaluation.recorded.truth, evaluation.tracked,
                  fs::path(options.scenario).stem().string() + ": top view");
   if (!last_image.empty()) {
     result.picture_paths.push_back((out / "last_frame.png").string());
     cv::imwrite(result.picture_paths.back(), last_image);
   }
   result.table = eval::formatResultsTable(result.metrics);
-  if (scenario.ppa.enabled && scenario.ppa.target_extraction && !targets_ne_m.empty() &&
-      recorded.sources.count("ppa") != 0) {
-    TargetPassInput passes;
-    passes.truth = recorded.truth;
-    for (const core::StampedPose& pose : recorded.truth) {
-      passes.truth_height_m.push_back(terrain::heightAboveGround_m(
-          *camera.scene().built.world, pose.p_ned_m.x(), pose.p_ned_m.y(), pose.p_ned_m.z()));
-    }
-    passes.estimates = recorded.sources.at("ppa");
-    passes.detector_frames = detector_frames;
-    passes.targets_ne_m = targets_ne_m;
-    passes.hfov_rad = scenario.camera.camera.hfov_deg * std::numbers::pi / 180.0;
-    result.target_passes = targetPasses(passes);
-    result.table += "\n" + formatTargetPasses(result.target_passes);
-    std::ofstream(out / "target_passes.csv") << targetPassesCsv(result.target_passes);
+  const nodes::BatchReportInput report_input{scenario, result.log_path, result.out_dir,
+                                             *camera.scene().built.world};
+  for (const auto& [entry, params] : processing) {
+    const std::string section = entry->batchReport(report_input, params);
+    if (!section.empty()) result.table += "\n" + section;
   }
   return result;
 }
 
 void writeEffectiveScenario(const std::string& dir, const std::string& command,
-                            scenario::ScenarioParams& scenario) {
+                            nodes::ScenarioParams& scenario) {
   std::ofstream(fs::path(dir) / kScenarioName) << "# " << command << ": the effective scenario\n"
                                                << core::formatParamsOf(scenario);
 }

@@ -11,9 +11,8 @@
 #include <vector>
 
 #include "logs/eval/run_metrics.h"
-#include "run/target_passes.h"
 
-namespace nadir::scenario {
+namespace nadir::nodes {
 struct ScenarioParams;
 }
 
@@ -50,8 +49,7 @@ struct RunResult {
   std::vector<std::string> picture_paths;
   eval::RunMetrics metrics;
   RunProgress totals;
-  // Passes over the scenario's known targets, with the PPA's detections and errors.
-  std::vector<TargetPass> target_passes;
+  // The metrics table, then what the nodes add (the PPA's target passes).
   std::string table;
 };
 
@@ -65,7 +63,7 @@ RunResult runScenario(const RunOptions& options,
 // Writes dir/scenario.yaml: the scenario as it ran, under "# <command>: the
 // effective scenario" (nadir run and nadir launch; the viewers take its terrain).
 void writeEffectiveScenario(const std::string& dir, const std::string& command,
-                            scenario::ScenarioParams& scenario);
+                            nodes::ScenarioParams& scenario);
 
 struct RunPlots {
   std::vector<std::string> png_paths;  // what nadir-plot wrote into the plots folder

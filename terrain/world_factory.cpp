@@ -1,5 +1,7 @@
 #include "terrain/world_factory.h"
 
+#include <filesystem>
+
 #include <numbers>
 
 #include "terrain/elevation.h"
@@ -74,6 +76,14 @@ BuiltWorld makeWorld(const WorldParams& params) {
   built.world = std::make_shared<GeoWorld>(std::move(elevation), std::move(imagery),
                                            core::LocalNedFrame(built.origin));
   return built;
+}
+
+void resolvePathsFrom(WorldParams& params, const std::string& folder) {
+  for (std::string* path : {&params.dem_path, &params.imagery_path, &params.imagery_red_path,
+                            &params.imagery_green_path, &params.imagery_blue_path}) {
+    if (path->empty() || std::filesystem::path(*path).is_absolute()) continue;
+    *path = (std::filesystem::path(folder) / *path).lexically_normal().string();
+  }
 }
 
 }  // namespace nadir::terrain

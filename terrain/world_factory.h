@@ -47,4 +47,8 @@ struct BuiltWorld {
 // Throws TerrainError (files) or core::ParamError (bad values) naming what is wrong.
 BuiltWorld makeWorld(const WorldParams& params);
 
+// Makes the world's relative file paths relative to `folder` (the folder of
+// the file that named them).
+void resolvePathsFrom(WorldParams& params, const std::string& folder);
+
 }  // namespace nadir::terrain

@@ -1,10 +1,9 @@
 #pragma once
-// Everything nadir-camera reads from its YAML file and --set overrides.
+// Everything nadir-camera reads from its YAML file (or a scenario) and --set overrides.
 
 #include <map>
 #include <string>
 
-#include "core/bus.h"
 #include "core/params.h"
 #include "nodes/camera/camera_rig.h"
 #include "render/terrain_renderer.h"
@@ -15,7 +14,6 @@
 namespace nadir::camera {
 
 struct CameraNodeParams {
-  core::BusParams bus;
   std::string pose_channel = "POSE_TRUTH";
   terrain::WorldParams world;
   terrain::TileParams tiles;
@@ -25,7 +23,6 @@ struct CameraNodeParams {
   std::map<std::string, terrain::GroundTarget> targets;
 
   void visit(core::ParamVisitor& v) {
-    core::visitGroup(v, "bus", "where messages come from and go", bus);
     v.field("pose_channel", &pose_channel,
             {.doc = "pose_t channel of the body the cameras ride on"});
     core::visitGroup(v, "world", "the terrain", world);

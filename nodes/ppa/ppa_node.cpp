@@ -46,6 +46,13 @@ void PpaNodeParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "host", "pixels to metres, integration, target correction", host);
 }
 
+void PpaProcessParams::visit(core::ParamVisitor& v) {
+  node.visit(v);
+  v.field("known_targets_ne_m", &known_targets_ne_m,
+          {.doc = "[north_m, east_m] of the known concentric targets (a scenario's targets)",
+           .row_sizes = {2}});
+}
+
 PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
                  std::vector<Eigen::Vector2d> targets_ne_m)
     : bus_(bus),

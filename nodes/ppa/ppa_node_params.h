@@ -35,4 +35,14 @@ struct PpaNodeParams {
   void visit(core::ParamVisitor& v);
 };
 
+// What the nadir-ppa process reads: its scenario group's fields at the top level,
+// and the known targets (which a scenario gives by its concentric targets).
+struct PpaProcessParams {
+  PpaNodeParams node;
+  // [north_m, east_m] of each known concentric target, world frame.
+  core::NumberRows known_targets_ne_m;
+
+  void visit(core::ParamVisitor& v);
+};
+
 }  // namespace nadir::ppa

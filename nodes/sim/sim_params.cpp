@@ -87,4 +87,17 @@ void SimParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "sensors", "sensor models", sensors);
 }
 
+void TimeParams::visit(core::ParamVisitor& v) {
+  v.field("mode", &mode,
+          {.doc = "realtime (paced at speed x real time) or batch (as fast as possible)",
+           .choices = {"realtime", "batch"}});
+  v.field("speed", &speed, {.doc = "realtime: multiple of real time", .min = 0.01, .max = 1000});
+}
+
+void SimNodeParams::visit(core::ParamVisitor& v) {
+  sim.visit(v);
+  core::visitGroup(v, "world", "the terrain and the world frame's origin", world);
+  core::visitGroup(v, "time", "how sim time runs", time);
+}
+
 }  // namespace nadir::sim

@@ -1,7 +1,7 @@
 #pragma once
 // What nadir-sim simulates, as parameters: the vehicle, where it starts, the
 // route it follows (or a recorded flight to replay), the truth stream and the
-// sensors. A scenario (scenario/) holds these at its top level, so that
+// sensors. A scenario (nodes/scenario.h) holds these at its top level, so that
 // `--set vehicle.airspeed_mps=25` reaches FixedWingParams::airspeed_mps.
 
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include "core/params.h"
 #include "nodes/sim/sensors.h"
 #include "nodes/sim/vehicles.h"
+#include "terrain/world_factory.h"
 
 namespace nadir::sim {
 
@@ -125,6 +126,25 @@ struct SimParams {
   SensorsParams sensors;
 
   // Visits the fields at the top level of a scenario.
+  void visit(core::ParamVisitor& v);
+};
+
+// How sim time runs when nadir-sim flies live (a batch run is as fast as it can).
+struct TimeParams {
+  // "realtime" paces the streams at speed x real time; "batch" runs as fast as possible.
+  std::string mode = "realtime";
+  double speed = 1.0;
+
+  void visit(core::ParamVisitor& v);
+};
+
+// What the nadir-sim process reads: the simulator's keys at the top level, as in
+// a scenario, with the world it flies over and how time runs.
+struct SimNodeParams {
+  SimParams sim;
+  terrain::WorldParams world;
+  TimeParams time;
+
   void visit(core::ParamVisitor& v);
 };
 

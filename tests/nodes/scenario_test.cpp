@@ -19,7 +19,7 @@
 #include "nodes/sim/simulator.h"
 #include "terrain/world_factory.h"
 
-namespace nadir::scenario {
+namespace nadir::nodes {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -412,4 +412,4 @@ TEST(Scenario, FlightCsvRoundTripsThroughTheTruthStream) {
 }
 
 }  // namespace
-}  // namespace nadir::scenario
+}  // namespace nadir::nodes

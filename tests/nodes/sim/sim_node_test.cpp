@@ -94,7 +94,7 @@ TEST(SimNode, BatchRunWritesTheStreamsToALog) {
           " scamp-rectangle --set duration_s=2 --set time.mode=batch --set bus.url=file://" + log +
           "?mode=w");
   ASSERT_EQ(status, 0) << output;
-  EXPECT_NE(output.find("nadir-sim: done after 2 s of sim time"), std::string::npos) << output;
+  EXPECT_NE(output.find("nadir-sim: done; 2 s of sim time"), std::string::npos) << output;
   const LogContents contents = readLog(log);
   EXPECT_EQ(contents.counts.at("POSE_TRUTH"), 801);
   EXPECT_EQ(contents.counts.at("IMU"), 801);           // 400 Hz in this scenario

@@ -14,7 +14,7 @@
 #include "core/trajectory.h"
 #include "logs/run_log.h"
 
-namespace nadir::run {
+namespace nadir::ppa {
 
 struct TargetPass {
   int target = 0;  // index into the targets given
@@ -43,4 +43,4 @@ std::vector<TargetPass> targetPasses(const TargetPassInput& input);
 std::string formatTargetPasses(const std::vector<TargetPass>& passes);
 std::string targetPassesCsv(const std::vector<TargetPass>& passes);
 
-}  // namespace nadir::run
+}  // namespace nadir::ppa

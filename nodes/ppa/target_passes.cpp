@@ -1,10 +1,10 @@
-#include "run/target_passes.h"
+#include "nodes/ppa/target_passes.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-namespace nadir::run {
+namespace nadir::ppa {
 namespace {
 
 // Horizontal error of the TRACKING estimate nearest t_s (within 0.1 s).
@@ -103,4 +103,4 @@ std::string targetPassesCsv(const std::vector<TargetPass>& passes) {
   return csv;
 }
 
-}  // namespace nadir::run
+}  // namespace nadir::ppa

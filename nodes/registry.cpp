@@ -1,0 +1,40 @@
+#include "nodes/registry.h"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace nadir::nodes {
+
+// Each node's entry, defined in its folder (nodes/<name>/<name>_entry.cpp).
+std::unique_ptr<Entry> cameraEntry();
+std::unique_ptr<Entry> ppaEntry();
+std::unique_ptr<Entry> voFeatureEntry();
+std::unique_ptr<Entry> simEntry();
+
+bool Node::turn(core::Bus& bus) {
+  bus.handle(std::chrono::milliseconds(100));
+  return true;
+}
+
+const std::vector<std::unique_ptr<Entry>>& registry() {
+  static const std::vector<std::unique_ptr<Entry>> entries = [] {
+    std::vector<std::unique_ptr<Entry>> list;
+    list.push_back(cameraEntry());
+    list.push_back(ppaEntry());
+    list.push_back(voFeatureEntry());
+    list.push_back(simEntry());
+    return list;
+  }();
+  return entries;
+}
+
+const Entry& entry(std::string_view name) {
+  std::string names;
+  for (const auto& candidate : registry()) {
+    if (candidate->info().name == name) return *candidate;
+    names += (names.empty() ? "" : ", ") + candidate->info().name;
+  }
+  throw std::invalid_argument("no node named '" + std::string(name) + "' (nodes: " + names + ")");
+}
+
+}  // namespace nadir::nodes
