@@ -1,5 +1,5 @@
 // nadir-bench-ppa: the SCAMP-5 emulator running the on-sensor programs of
-// seed 000 on one core: image-alignment visual odometry and target extraction
+// McConville et al. (2020) on one core: image-alignment visual odometry and target extraction
 // on every frame of a moving textured scene (256x256 frames cut, with drift,
 // yaw and a slow height change, from a large synthetic texture with a
 // concentric target mat in it). Prints frames/s, ns per frame and instructions

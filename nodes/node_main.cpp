@@ -25,6 +25,8 @@ void onSignal(int) { g_stop = true; }
 
 // A --config file: the bus, then the node's own keys at the top level.
 struct ProcessParams {
+  explicit ProcessParams(core::AnyParams node_params) : node(std::move(node_params)) {}
+
   core::BusParams bus;
   core::AnyParams node;
 
@@ -98,7 +100,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
   }
 
   try {
-    ProcessParams params{{}, node_entry.defaultParams()};
+    ProcessParams params(node_entry.defaultParams());
     std::string source;
     if (!config_path.empty()) {
       core::applyYamlFile(config_path, [&params](core::ParamVisitor& v) { params.visit(v); });

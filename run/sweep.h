@@ -2,7 +2,7 @@
 // `nadir sweep`: a grid of parameter values (the thesis's experiment grid)
 // flown cell by cell by `nadir run` child processes in parallel, then one
 // table of position RMSE, rotation RMSE and robustness per cell and per VO,
-// laid out like the thesis's tables 1 and 2 (seed 002).
+// laid out like the thesis's tables 1 and 2 (Kim 2019).
 //
 // SWEEP.yaml:
 //   scenario: thesis-oscillating

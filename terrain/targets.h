@@ -1,9 +1,9 @@
 #pragma once
 // Ground targets: printed mats laid on the ground at known positions, drawn
 // into the camera images at far finer resolution than the terrain imagery.
-//  - concentric: nested black square rings on white (seed 000's target, found
+//  - concentric: nested black square rings on white (McConville et al.'s (2020) target, found
 //    by flooding from the border and inverting N times);
-//  - gate: four black disks inside two concentric black squares (seed 001).
+//  - gate: four black disks inside two concentric black squares (Liu et al. 2021).
 
 #include <string>
 #include <vector>

@@ -1,8 +1,8 @@
 #pragma once
 // Trajectory error metrics:
 //  - APE and RPE exactly as the evo tool defines them (evo/core/metrics.py),
-//  - the thesis's position and rotation RMSEs (seed 002, section 3.3.6),
-//  - seed 000's mean absolute error (track length: trajectory.h's trackLength),
+//  - the thesis's position and rotation RMSEs (Kim 2019, section 3.3.6),
+//  - McConville et al.'s (2020) mean absolute error (track length: trajectory.h's trackLength),
 //  - evo's statistics over an error vector.
 // Poses are T_world_body (trajectory.h). "ref" is the truth, "est" the estimate;
 // the two trajectories passed to a metric are associated pose by pose (same size).
@@ -47,7 +47,7 @@ struct EvalOptions {
   // Run metrics: an estimate is not compared if the truth samples around it are
   // further apart than this (a hole in a damaged log), s.
   double truth_max_gap_s = 0.5;
-  // Run metrics: path lengths (seed 000's track length) sum the distances
+  // Run metrics: path lengths (McConville et al.'s (2020) track length) sum the distances
   // between samples at least this far apart in time (and each segment's last),
   // s; 0 uses every estimate. Sampled finely, a pixel's jitter in a 200 Hz
   // estimate adds to its path what the flight did not fly.
@@ -89,7 +89,7 @@ struct RelativeErrors {
 RelativeErrors rpeErrors(const core::Trajectory& ref, const core::Trajectory& est,
                          const IndexPairs& pairs);
 
-// Thesis (seed 002) eq. 13: sqrt( sum_i [(x'_i-x_i)^2 + (y'_i-y_i)^2 + (z'_i-z_i)^2] / n ),
+// Thesis (Kim 2019) eq. 13: sqrt( sum_i [(x'_i-x_i)^2 + (y'_i-y_i)^2 + (z'_i-z_i)^2] / n ),
 // the sum of the three squared axis errors over n poses: the RMSE of the norm
 // of the position error vector (not the per-axis RMSE, which is sqrt(3) smaller). m.
 double thesisPositionRmse(const core::Trajectory& ref, const core::Trajectory& est);
@@ -99,7 +99,7 @@ double thesisPositionRmse(const core::Trajectory& ref, const core::Trajectory& e
 // frame-independent alternative. Degrees.
 double thesisRotationRmseDeg(const core::Trajectory& ref, const core::Trajectory& est);
 
-// Seed 000's mean absolute error: mean over poses of |p_est,i - p_ref,i|, m.
+// McConville et al.'s (2020) mean absolute error: mean over poses of |p_est,i - p_ref,i|, m.
 double meanAbsoluteError(const core::Trajectory& ref, const core::Trajectory& est);
 
 // The `--ref/--est` evaluation: associate (t_max_diff_s), align, APE and RPE.

@@ -22,8 +22,9 @@ void CameraNode::onPose(const msg::Pose& pose) {
   T_world_body.linear() = pose.q_world_body.toRotationMatrix();
   T_world_body.translation() = pose.p_ned_m;
   for (const CameraFrame& frame : rig_.onPose(pose.utime, T_world_body)) {
-    msg::publish(bus_, frame.spec->channel,
-                 msg::Image{frame.rendered.utime, frame.rendered.image, frame.spec->jpeg_quality});
+    msg::publish(
+        bus_, frame.spec->channel,
+        msg::Image{frame.rendered.utime, frame.rendered.image, frame.spec->jpeg_quality, {}});
     // camera_info_t with the first frame, then once a second (and after a jump back).
     auto [last, first] = last_info_utime_.try_emplace(frame.name, pose.utime);
     if (first || pose.utime - last->second >= 1'000'000 || pose.utime < last->second) {

@@ -29,8 +29,9 @@ void GateTrackerParams::visit(core::ParamVisitor& v) {
           {.doc = "PIX counts below which a PE is dark", .min = -128.0, .max = 127.0});
   v.field("boundaries", &boundaries,
           {.doc = "flood-and-invert rounds that leave the disks", .min = 1, .max = 64});
-  v.field("denoise_step", &denoise_step,
-          {.doc = "de-noising shift (seed 001's P_step), PEs; 0: off", .min = 0, .max = 16});
+  v.field(
+      "denoise_step", &denoise_step,
+      {.doc = "de-noising shift (Liu et al.'s (2021) P_step), PEs; 0: off", .min = 0, .max = 16});
   v.field("min_disk_px", &min_disk_px,
           {.doc = "smallest disk bounding box side, px", .min = 1, .max = 256});
   v.field("max_disk_px", &max_disk_px,

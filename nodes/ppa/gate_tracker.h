@@ -1,5 +1,5 @@
 #pragma once
-// Gate pattern tracking on the pixel processor array (seed 001, algorithms 1
+// Gate pattern tracking on the pixel processor array (Liu et al. 2021, algorithms 1
 // and 2), written as a kernel of Ppa instructions: four black disks inside two
 // concentric black squares.
 //

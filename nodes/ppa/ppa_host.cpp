@@ -12,7 +12,9 @@ void PpaHostParams::visit(core::ParamVisitor& v) {
            .min = 1,
            .max = 170});
   v.field("scale_correction", &scale_correction,
-          {.doc = "seed 000's f(h): factor on measured distances", .min = 0.1, .max = 10});
+          {.doc = "McConville et al.'s (2020) f(h): factor on measured distances",
+           .min = 0.1,
+           .max = 10});
   v.field("target_gate_m", &target_gate_m,
           {.doc = "correct on a known target within this distance of the estimate, m; 0 = off",
            .min = 0,
@@ -112,7 +114,8 @@ PpaHostOutput PpaHost::update(const PpaHostInput& input) {
       }
     }
     if (nearest != nullptr && nearest_m <= params_.target_gate_m) {
-      // Seed 000 section 3.2: the target's known position, zero error in the distance.
+      // McConville et al. (2020) section 3.2: the target's known position, zero error in the
+      // distance.
       const Eigen::Vector2d corrected = *nearest - to_target_m;
       out.correction_m =
           Eigen::Vector3d(corrected.x() - out.p_ned_m.x(), corrected.y() - out.p_ned_m.y(), 0.0);

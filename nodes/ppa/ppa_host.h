@@ -1,5 +1,5 @@
 #pragma once
-// The host side of the PPA's visual odometry (seed 000, section 2.3.1,
+// The host side of the PPA's visual odometry (McConville et al. 2020, section 2.3.1,
 // equations 1-5): the chip reports how the current frame aligns to its
 // key-frame in pixels; the host turns that into metres with the rangefinder's
 // height and the lens, removes the apparent motion the vehicle's rotation
@@ -10,7 +10,7 @@
 // ground point directly below the vehicle now is found in the current image
 // (through the current attitude), carried into the key-frame's image by the
 // chip's alignment, and cast back onto the ground from the key-frame's pose
-// and height. With level flight this is seed 000's d = h tan(F/2) / 128 * px
+// and height. With level flight this is McConville et al.'s (2020) d = h tan(F/2) / 128 * px
 // per pixel, minus h tan(attitude change) for rotations, rotated by the yaw.
 //
 // No LCM: plain structs in and out.
@@ -29,7 +29,7 @@ namespace nadir::ppa {
 struct PpaHostParams {
   // Lens field of view, deg, used when no camera_info_t has been received.
   double hfov_deg = 50.0;
-  // Seed 000's f(h): a factor on the measured distances (1 for nadir's ideal lens).
+  // McConville et al.'s (2020) f(h): a factor on the measured distances (1 for nadir's ideal lens).
   double scale_correction = 1.0;
   // Correct the position when a known target is seen within this distance of
   // where the estimate expects it, m; 0 turns target correction off.

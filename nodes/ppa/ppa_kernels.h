@@ -62,7 +62,7 @@ class Program {
 // enter at the edges. |dx| + |dy| moves; dst may be src.
 void translate(Program& program, Dreg dst, Dreg src, int dx, int dy);
 
-// Seed 001, algorithm 2: dst = AND of src moved `step` PEs north, south, west
+// Liu et al. 2021, algorithm 2: dst = AND of src moved `step` PEs north, south, west
 // and east, which removes white specks and lines narrower than 2 step + 1 and
 // shrinks regions by `step` without moving their centres. tmp is clobbered;
 // dst, src and tmp must differ.
@@ -75,7 +75,7 @@ int countAnd(Program& program, Dreg a, Dreg b, Dreg tmp);
 // left holding the image, B and F are clobbered, FLAG is all on return.
 void binariseDark(Program& program, Dreg dst, double threshold_counts);
 
-// Seed 000's flood-and-invert, `boundaries` (>= 1) times, starting from the
+// McConville et al.'s (2020) flood-and-invert, `boundaries` (>= 1) times, starting from the
 // bright set `bright` (consumed): dst = the PEs inside more than `boundaries`
 // boundaries of the binary image. tmp is clobbered; dst, bright and tmp differ.
 void floodAndInvert(Program& program, Dreg dst, Dreg bright, int boundaries, Dreg tmp);

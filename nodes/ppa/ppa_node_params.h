@@ -17,7 +17,7 @@ struct PpaNodeParams {
   std::string image_channel = "CAMERA_PPA";
   std::string info_channel = "CAMERA_PPA_INFO";
   std::string range_channel = "RANGE";
-  // The flight controller's attitude (seed 000 used the vehicle's IMU attitude).
+  // The flight controller's attitude (McConville et al. 2020 used the vehicle's IMU attitude).
   std::string attitude_channel = "NAV_ATTITUDE";
   // Read once: the start pose the estimate is anchored to.
   std::string truth_channel = "POSE_TRUTH";

@@ -1,5 +1,5 @@
 #pragma once
-// Target extraction on the pixel processor array (seed 000, section 2.2.2),
+// Target extraction on the pixel processor array (McConville et al. 2020, section 2.2.2),
 // written as a kernel of Ppa instructions: the image is binarised (dark target
 // rings against the bright mat), then flooded from the array's border,
 // inverted, and so on `boundaries` times; whatever is left lies inside more

@@ -1,6 +1,6 @@
 #pragma once
 // Passes over the known ground targets and what a pose source made of them:
-// seed 000's test of target correction (section 3.2). A pass is a stretch of
+// McConville et al.'s (2020) test of target correction (section 3.2). A pass is a stretch of
 // the truth during which a target lies well inside the camera's view; for
 // each, whether the detector reported the target, and the source's position
 // error as the pass began and as it ended.

@@ -1,52 +1,9 @@
 #pragma once
-// Image-alignment visual odometry on the pixel processor array (seed 000,
-// section 2.2.1, after Bose et al. 2017), written as a kernel of Ppa
-// instructions; the host only reads global counts.
-//
-// Each frame: an HDR edge image from the log-response PIX (a PE is an edge
-// when it is brighter than one of its four neighbours by more than
-// edge_threshold counts), then an alignment to the key-frame's edge image by
-// small adjustments in opposite pairs (translate left/right, up/down, rotate
-// clockwise/anti-clockwise, scale up/down), each scored by the strength
-// popcount(warped edges AND key-frame edges) / key-frame edges, starting from
-// the previous frame's transform. A new key-frame is taken when the strength
-// falls below keyframe_strength.
-//
-// The score of a transform T (this frame's pixel q shows the key-frame's T(q))
-// is the overlap sum_q E(q) K(T(q)): this frame's edge image E against the
-// key-frame's edge image K pulled through T. That is the overlap of E aligned
-// by T with K, up to resampling, and it lets the warped key-frames live in
-// registers across frames: K does not change until the next key-frame, E does.
-//
-// The transform is held as integers: rotation k_r steps, scale k_s steps and
-// a translation u px, T(q) = c + M (q + u - c), M = (1 + scale_step)^k_s
-// R(k_r rotation_step), c the array's centre (the reported translation is
-// M u). Every warped key-frame is rendered from the ORIGINAL K for the total
-// (k_r, k_s), never from a warped copy, so nothing compounds:
-//   G(q) = K(c + M (q - c))
-// is built from four families of masked moves, each moving every row or
-// column by its own whole number of PEs:
-//   1. x shifts by row (a shear: each row moves rigidly);
-//   2. x shifts by column (a stretch: columns repeat or drop);
-//   3. y shifts by column (a shear);
-//   4. y shifts by row (a stretch).
-// A family out(z) = in(z + f(z)), f(z) = round(slope (z - c)), is the OR over
-// k of (in moved k PEs) AND band_k, band_k the rectangle of rows or columns
-// where f = k (one band each, f being monotonic): the moved copies are made one
-// move at a time outwards from k = 0, so a family costs 5 instructions per k.
-// The x families give K(x + cu(x) + ru(y), y), the y families then take row
-// y + cv(x) + rv(y) of that; cu, ru, cv, rv are the rounded linear fields
-// that make the four together the rotation and scaling M (to rounding,
-// <= 1 px). A transform with |rotation| + |scale - 1| = e costs about
-// 2 * 256 * e steps of 5 instructions. The current G and its four
-// rotation/scale neighbours stay rendered (R7..R11) while only the translation
-// changes, across frames too.
-//
-// The translation moves E instead (E_u(r) = E(r - u), |u| single moves, then
-// one move per accepted step; re-made from E when a move would lose its
-// border), and popcount(E_u AND G) is exactly the overlap sum_q E(q) G(q + u).
-// A translation candidate moves E_u one PE and counts (4 instructions); a
-// rotation/scale candidate ANDs and counts a rendered G (3 instructions).
+// Image-alignment visual odometry on the pixel processor array (McConville et
+// al. 2020, section 2.2.1, after Bose et al. 2017), written as a kernel of Ppa
+// instructions; the host only reads global counts. Each frame's edge image is
+// aligned to the key-frame's by small steps of translation, rotation and scale;
+// docs/ppa.md ("How the alignment is computed") says how, and what it costs.
 
 #include <cstdint>
 

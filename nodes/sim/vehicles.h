@@ -91,7 +91,7 @@ class FixedWing {
 
 // Multirotor: flies each leg at a set speed with limited acceleration,
 // stopping at waypoints; with yaw_at_corners it turns on the spot to face each
-// new leg (the 90 deg yaw at the rectangle's corners of seed 000). Tilt follows
+// new leg (the 90 deg yaw at the rectangle's corners of McConville et al. (2020)). Tilt follows
 // the acceleration.
 struct MultirotorParams {
   double speed_mps = 3.0;
@@ -132,7 +132,7 @@ class Multirotor {
 
 // Ground rover: kinematic bicycle model (rear-axle reference point) on flat
 // ground at a constant speed, steering limited in angle and rate, following
-// waypoints by pure pursuit (for seed 001's gate and slalom tasks).
+// waypoints by pure pursuit (for Liu et al.'s (2021) gate and slalom tasks).
 struct RoverParams {
   double speed_mps = 1.0;
   double wheelbase_m = 0.3;

@@ -1,65 +1,10 @@
 #pragma once
-// The tracking core of the feature-based monocular VO (seed 002; ORB-SLAM2's
-// tracking and local mapping, loop closing off): plain structs in and out, no
-// LCM.
-//
-// Initialisation: the first frame after setStartPose is the reference; later
-// frames are matched to it by brute force (+ the rotation consistency check)
-// until initialiseTwoView succeeds. The reference camera's world pose is
-// T_world_body_start * T_body_cam: the VO assumes the vehicle is at the start
-// pose when the reference frame is taken (nadir anchors every VO at the truth
-// of its first frame). Metric scale: the map's range along the rangefinder's
-// ray (the median distance along the ray of the points seen within
-// range_window_px of the ray's image; the window grows to 4x if too few) is
-// set to the measured range. Without a range the two-view translation keeps
-// unit norm (the map is then up to an unknown scale). While initialising, the
-// published pose is the reference's pose.
-//
-// Tracking: a constant-velocity model (or the attitude prior's rotation with
-// the model's position) predicts the camera; the map points of the local
-// key-frames are projected into the frame and matched within a window around
-// their predictions (a wider window when too few match), the pose is found by
-// cv::solvePnPRansac and refined by a motion-only bundle adjustment (points
-// fixed, Huber loss, outliers dropped; with the attitude prior, a prior on the
-// camera's attitude of attitude_prior_sigma_deg). Fewer than min_tracked_points
-// inliers after the wide window: LOST for this frame, the published pose is
-// the motion model's extrapolation, and the next frames try again from the
-// extrapolation.
-//
-// Re-initialisation: after lost_frames_before_reset consecutive lost frames
-// the map is dropped (num_resets counts) and a new one starts in the same
-// world frame at the extrapolated pose, so the published pose continues from
-// the extrapolation and never jumps back. With a range (reinit_from_range) the
-// new map is made at once from this frame: every feature's ray is met with the
-// level plane through the ground point the rangefinder sees; if the next frame
-// cannot track it, it is made again from that frame. Without a range, the
-// frame becomes a two-view reference as at the start.
-//
-// Key-frames: a frame becomes one when the last key-frame's map points it
-// tracks fall below keyframe_min_shared_ratio of the most any frame since that
-// key-frame tracked, or its rotation from the last key-frame exceeds
-// keyframe_max_rotation_deg (distance alone fails in turns). Its unmatched
-// features are matched to the unmatched ones of up to triangulation_keyframes
-// earlier key-frames that share its view, widest baseline first (windows around
-// the positions predicted through the level plane of the earlier key-frame's
-// points: a plane, unlike a depth, holds for an oblique view), and triangulated
-// with the parallax and reprojection checks. Then a local bundle adjustment
-// refines the last local_window key-frames (the oldest one fixed: it holds the
-// position and attitude gauge; the scale is left to the points and the range
-// correction below) and their points, with the attitude priors of the
-// key-frames that have one, every ba_every_keyframes key-frames. Live
-// (background_ba) it runs in a thread and its result is taken in at the first
-// frame after it finishes; in nadir run it runs at its key-frame so that runs
-// are byte-identical.
-//
-// Scale upkeep: at each key-frame with a range, the map's range along the ray
-// is compared with the measured one; their ratio is reported
-// (lastScaleRatio). When it is off by more than scale_tolerance, the points
-// the new key-frame sees are scaled about its camera centre by
-// 1 + scale_gain * (1 / ratio - 1), and so is the motion model's translation:
-// the published pose does not move, the following motion comes out closer to
-// metric, and the next local BA spreads it. A gain below 1 keeps a single noisy
-// range from bending the map.
+// The tracking core of the feature-based monocular VO (Kim 2019; ORB-SLAM2's
+// tracking and local mapping, loop closing off): frames and the rangefinder's
+// range in, T_world_body out, plain structs, no LCM. Two-view initialisation,
+// PnP tracking against the local map, key-frames on shared points or rotation,
+// a local bundle adjustment, metric scale from the range, re-initialisation
+// after a loss: docs/vo_feature.md says how each works.
 
 #include <cstdint>
 #include <deque>

@@ -1,5 +1,5 @@
 #pragma once
-// ORB features for the feature-based monocular VO (seed 002, ORB-SLAM2), and
+// ORB features for the feature-based monocular VO (Kim 2019, ORB-SLAM2), and
 // the descriptor matching the tracker and the initialiser use.
 //
 // Extraction follows ORB-SLAM's ORBextractor: a scale pyramid (each level

@@ -1,47 +1,9 @@
 #pragma once
-// Two-view initialisation of the monocular map, as ORB-SLAM2 does it (seed 002,
-// ORB-SLAM; Mur-Artal et al. 2015, section IV).
-//
-// A downward camera at altitude sees nearly planar ground: the essential matrix
-// alone is badly conditioned there (a plane is a critical surface for the
-// 5/8-point solvers, and many motions explain the matches almost equally), so
-// both models are fitted in parallel on the matched normalised points:
-//   H: cv::findHomography (RANSAC)       E: cv::findEssentialMat (RANSAC)
-// and each is scored over all matches by the symmetric transfer error in
-// pixels against a chi-square model (sigma = sigma_px):
-//   S_M = sum over both images of (T_M - d^2 / sigma^2) where d^2 / sigma^2 < T_M,
-//   T_H = 5.991 (2 dof, 95 %), T_E = 3.841 (1 dof, 95 %; scored with 5.991 like H).
-// The homography wins when R_H = S_H / (S_H + S_E) > homography_ratio (0.45,
-// the value of the ORB-SLAM paper; its code uses 0.40): a plane or a low
-// parallax scene, where H explains as much as E with fewer parameters.
-// The ratio of a plane depends on the keypoint noise: the transfer error
-// carries the noise of both images in 2 dof against the epipolar distance's 1,
-// so a plane scores R_H ~ 0.5 when the noise is well below sigma_px, and only
-// ~0.41 when it equals sigma_px (then E wins on a plane, where E is ambiguous
-// and the checks below mostly refuse it). Keep sigma_px at about twice the
-// keypoints' noise (ORB-SLAM: sigma 1 px with level-0 keypoints).
-//
-// The motion candidates are the decompositions (H: cv::decomposeHomographyMat,
-// 4; E: cv::decomposeEssentialMat, 4). Each candidate triangulates every inlier
-// of its model. A point is consistent with the candidate when it reprojects
-// within max_reprojection_error_px in both images and lies in front of both
-// cameras (the side is not asked of points with less parallax than
-// min_point_parallax_deg: their depth sign is noise); it is triangulated when
-// it is consistent, in front and has at least min_point_parallax_deg. The
-// candidate with the most triangulated points wins (a wrong one puts points
-// behind a camera, or, the wrong solution of a plane, moves towards a "wall"
-// and leaves no parallax near its focus of expansion), unless
-//   - the median parallax of its consistent points is below min_parallax_deg
-//     (pure rotation, a tiny baseline: depth is unknowable),
-//   - the second best triangulates at least ambiguity_ratio times as many (the
-//     twofold ambiguity of a plane, a degenerate configuration),
-//   - its consistent points are fewer than min_good_fraction of the model's
-//     inliers, or
-//   - it triangulates fewer than min_triangulated points.
-// The winner is refined on the Sampson error of its triangulated points
-// (refine_motion: the fitted H or the minimal-sample E leave about a degree of
-// error at a few degrees of parallax) and triangulates again.
-// Refused initialisations say why; the tracker then waits for more motion.
+// Two-view initialisation of the monocular map, as ORB-SLAM2 does it (Kim 2019;
+// Mur-Artal et al. 2015, section IV): homography and essential matrix fitted in
+// parallel and scored, the motion chosen among their decompositions by the
+// points it triangulates, refused when ambiguous or with too little parallax.
+// docs/vo_feature.md ("Two-view initialisation") has the tests and thresholds.
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -55,7 +17,7 @@ namespace nadir::vo {
 
 struct TwoViewParams {
   // Standard deviation of a keypoint's position, px: scales the chi-square tests.
-  // About twice the real noise (see above) so a plane picks the homography.
+  // About twice the real noise so a plane picks the homography (docs/vo_feature.md).
   double sigma_px = 1.0;
   // Choose the homography when S_H / (S_H + S_E) exceeds this.
   double homography_ratio = 0.45;

@@ -137,7 +137,8 @@ void VoFeatureNode::publishDebugImage(const cv::Mat& frame, std::int64_t utime,
        << vo_.timing().keyframes << "  resets " << out.resets;
   msg::publish(
       bus_, params_.debug_channel,
-      msg::Image{utime, drawDebugImage(frame, features, text.str()), params_.debug_jpeg_quality});
+      msg::Image{
+          utime, drawDebugImage(frame, features, text.str()), params_.debug_jpeg_quality, {}});
 }
 
 }  // namespace nadir::vo

@@ -1,4 +1,4 @@
-// Scenarios: the built-in ones load and fly as the thesis and seed 000
+// Scenarios: the built-in ones load and fly as the thesis and McConville et al. (2020)
 // describe them; bad scenarios are refused with the key named; runs are
 // deterministic; a recorded flight comes back out of the truth stream.
 
@@ -183,8 +183,8 @@ TEST(Scenario, ThesisOscillatingRespectsRollLimits) {
   EXPECT_LE(max_roll_rate, 25.0 * kDeg * (1.0 + 1e-6));
 }
 
-// Seed 000: four laps of a 50 m x 25 m rectangle (4 x 150 m +- 2 %) at 5 m above the ground,
-// with a 90 deg yaw at every corner.
+// McConville et al. (2020): four laps of a 50 m x 25 m rectangle (4 x 150 m +- 2 %) at 5 m above
+// the ground, with a 90 deg yaw at every corner.
 TEST(Scenario, ScampRectangleIsFourLapsWithRightAngleYaws) {
   const ScenarioParams scenario = withoutSensors(loadScenario("scamp-rectangle"));
   const Flown flown = fly(scenario);

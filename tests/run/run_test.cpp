@@ -133,8 +133,8 @@ TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
   EXPECT_EQ(readFile(json), readFile(result.metrics_path));
 }
 
-// Seed 000's flight, one lap, the emulated SCAMP-5 without target correction: within the
-// issue's bounds (mean absolute error <= 1 m, end point <= 0.5 % of the track).
+// McConville et al.'s (2020) flight, one lap, the emulated SCAMP-5 without target correction:
+// within the bounds (mean absolute error <= 1 m, end point <= 0.5 % of the track).
 TEST(Run, PpaOdometryOnOneLapOfTheRectangle) {
   RunOptions options;
   options.scenario = "scamp-rectangle";

@@ -1,4 +1,4 @@
-// The per-run evaluation: robustness (tracked_pct), seed 000's metrics, a
+// The per-run evaluation: robustness (tracked_pct), McConville et al.'s (2020) metrics, a
 // source that never tracked, and the metrics.json round trip. Expected values
 // are worked out by hand.
 
@@ -85,8 +85,8 @@ TEST(EvalRunMetrics, SilentHoleHoldsThreePeriods) {
   EXPECT_NEAR(m.tracked_pct, 72.0, 1e-9);
 }
 
-// Seed 000 on three sides of a 100 m square against the same path scaled 0.9 about its start:
-// Path lengths sample every track_length_interval_s: a 200 Hz estimate that wobbles 1 cm
+// McConville et al. (2020) on three sides of a 100 m square against the same path scaled 0.9 about
+// its start: Path lengths sample every track_length_interval_s: a 200 Hz estimate that wobbles 1 cm
 // across a 10 m straight flight adds 200 x 2 cm of wobble at every estimate, none at 1 s.
 TEST(EvalRunMetrics, TrackLengthSamplesAtTheInterval) {
   core::Trajectory truth;

@@ -1,4 +1,4 @@
-// On-sensor gate tracking (seed 001) on cluttered synthetic scenes with
+// On-sensor gate tracking (Liu et al. 2021) on cluttered synthetic scenes with
 // terrain's gate mat pasted in: disk centres with the squares intact and broken.
 
 #include "nodes/ppa/gate_tracker.h"

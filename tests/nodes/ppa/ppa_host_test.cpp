@@ -1,5 +1,5 @@
 // The PPA host: pixels to metres with the height and lens, rotation removed with the
-// attitude, yaw applied, target correction (seed 000, equations 1-5, section 3.2).
+// attitude, yaw applied, target correction (McConville et al. 2020, equations 1-5, section 3.2).
 
 #include <gtest/gtest.h>
 
@@ -83,7 +83,8 @@ TEST(PpaHost, RotationIsNotMistakenForMotion) {
   const PpaHostOutput rolled = host.update(
       frame(5.0 / std::cos(4.0 * kDeg), {.roll_rad = 4.0 * kDeg}, -kF * std::tan(4.0 * kDeg), 0.0));
   EXPECT_NEAR(rolled.p_ned_m.head<2>().norm(), 0.0, 1e-9);
-  // Without the attitude the same pixels would read as seed 000's h tan(5 deg) = 0.437 m.
+  // Without the attitude the same pixels would read as McConville et al.'s (2020) h tan(5 deg) =
+  // 0.437 m.
   const PpaHostOutput ignored = host.update(frame(5.0, {}, 0.0, -kF * std::tan(5.0 * kDeg)));
   EXPECT_NEAR(ignored.p_ned_m.x(), 5.0 * std::tan(5.0 * kDeg), 1e-9);
 }
@@ -98,8 +99,8 @@ TEST(PpaHost, KeyframesChain) {
   EXPECT_NEAR(out.p_ned_m.x(), 40.0 * 5.0 / kF, 1e-9);
 }
 
-// A known target seen in the image sets the position (seed 000 section 3.2); one seen too
-// far from where the estimate expects it is ignored.
+// A known target seen in the image sets the position (McConville et al. 2020 section 3.2); one seen
+// too far from where the estimate expects it is ignored.
 TEST(PpaHost, KnownTargetCorrectsThePosition) {
   PpaHost host = makeHost({Eigen::Vector2d(3.0, 4.0)});
   host.initialise({0.5, 3.6, -5});  // the truth is (0, 4): the estimate is 0.5 m north, 0.4 m west

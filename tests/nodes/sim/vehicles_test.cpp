@@ -149,7 +149,7 @@ TEST(FixedWing, LegSpeedsChangeAirspeedAtTheAccelerationLimit) {
   EXPECT_NEAR(aircraft.state().v_ned_mps.norm(), 25.0, 1e-9);
 }
 
-// Seed 000's rectangle: 50 m x 25 m flown four times is 600 m, and the multirotor
+// McConville et al.'s (2020) rectangle: 50 m x 25 m flown four times is 600 m, and the multirotor
 // faces along each leg, yawing 90 deg at every corner.
 TEST(Multirotor, RectangleWithNinetyDegreeYaws) {
   MultirotorParams params;
