@@ -47,6 +47,20 @@ std::map<std::string, ChannelStats> Bus::stats() const {
   return {stats_.begin(), stats_.end()};
 }
 
+void Bus::publish(std::string_view channel, const void* data, std::size_t size,
+                  std::int64_t event_utime) {
+  send(channel, data, size, event_utime);
+  std::lock_guard lock(stats_mutex_);
+  auto it = sent_.find(channel);
+  if (it == sent_.end()) it = sent_.emplace(std::string(channel), 0).first;
+  ++it->second;
+}
+
+std::map<std::string, std::int64_t> Bus::sent() const {
+  std::lock_guard lock(stats_mutex_);
+  return {sent_.begin(), sent_.end()};
+}
+
 void Bus::countMessage(std::string_view channel, std::size_t size) {
   std::lock_guard lock(stats_mutex_);
   auto it = stats_.find(channel);

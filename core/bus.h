@@ -73,10 +73,10 @@ class Bus {
   // The URL this bus was opened with, after defaults were applied.
   virtual std::string url() const = 0;
 
-  // Sends one encoded message. event_utime is the message's own time; a log
-  // writer stores it as the event timestamp, live transports ignore it.
-  virtual void publish(std::string_view channel, const void* data, std::size_t size,
-                       std::int64_t event_utime) = 0;
+  // Sends one encoded message and counts it. event_utime is the message's own
+  // time; a log writer stores it as the event timestamp, live transports ignore it.
+  void publish(std::string_view channel, const void* data, std::size_t size,
+               std::int64_t event_utime);
 
   // Calls handler for every message whose channel fully matches channel_regex
   // (LCM's POSIX extended regex semantics).
@@ -92,6 +92,8 @@ class Bus {
 
   // Counters per channel, of every message this bus received.
   std::map<std::string, ChannelStats> stats() const;
+  // Messages sent through this bus per channel (what a node says it published).
+  std::map<std::string, std::int64_t> sent() const;
 
   // Called by the typed subscribe when bytes do not decode as the expected type.
   void countDecodeError(std::string_view channel);
@@ -102,6 +104,9 @@ class Bus {
     std::string channel_regex;
     RawHandler callback;
   };
+  // The transport's send of publish().
+  virtual void send(std::string_view channel, const void* data, std::size_t size,
+                    std::int64_t event_utime) = 0;
   virtual void addSubscription(const Handler& handler) = 0;
   virtual void removeSubscription(int id) = 0;
   void countMessage(std::string_view channel, std::size_t size);
@@ -111,6 +116,7 @@ class Bus {
   int next_id_ = 0;
   mutable std::mutex stats_mutex_;
   std::map<std::string, ChannelStats, std::less<>> stats_;
+  std::map<std::string, std::int64_t, std::less<>> sent_;
 };
 
 // Where a node's bus goes; every node has these under "bus" in its parameters.

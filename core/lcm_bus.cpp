@@ -31,8 +31,8 @@ LcmBus::~LcmBus() {
   lcm_destroy(lcm_);
 }
 
-void LcmBus::publish(std::string_view channel, const void* data, std::size_t size,
-                     std::int64_t /*event_utime*/) {
+void LcmBus::send(std::string_view channel, const void* data, std::size_t size,
+                  std::int64_t /*event_utime*/) {
   const std::string name(channel);
   if (lcm_publish(lcm_, name.c_str(), data, static_cast<unsigned int>(size)) != 0) {
     throw BusError("LCM could not publish " + std::to_string(size) + " bytes on '" + name +

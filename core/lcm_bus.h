@@ -22,8 +22,8 @@ class LcmBus final : public Bus {
   ~LcmBus() override;
 
   std::string url() const override { return url_; }
-  void publish(std::string_view channel, const void* data, std::size_t size,
-               std::int64_t event_utime) override;
+  void send(std::string_view channel, const void* data, std::size_t size,
+            std::int64_t event_utime) override;
   bool handle(std::chrono::milliseconds timeout) override;
 
  private:

@@ -89,8 +89,8 @@ std::string LogBus::url() const {
   return url;
 }
 
-void LogBus::publish(std::string_view channel, const void* data, std::size_t size,
-                     std::int64_t event_utime) {
+void LogBus::send(std::string_view channel, const void* data, std::size_t size,
+                  std::int64_t event_utime) {
   if (!writer_) {
     throw BusError("cannot publish on '" + std::string(channel) + "': " + options_.path +
                    " is open for reading");

@@ -33,8 +33,8 @@ class LogBus final : public Bus {
 
   std::string url() const override;
   // Write mode only: appends an event stamped event_utime.
-  void publish(std::string_view channel, const void* data, std::size_t size,
-               std::int64_t event_utime) override;
+  void send(std::string_view channel, const void* data, std::size_t size,
+            std::int64_t event_utime) override;
   // Read mode: dispatches the next event; false at the end of the log. Never
   // waits on the wall clock unless speed > 0. Write mode: always false.
   bool handle(std::chrono::milliseconds timeout) override;

@@ -1,6 +1,7 @@
 #include "gui/live_feed.h"
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 #include "lcmtypes/codec.h"
@@ -8,22 +9,38 @@
 namespace nadir::gui {
 
 LiveFeed::LiveFeed(core::Bus& bus, LiveFeedParams params)
-    : collector_(params.truth_channel), bus_(bus), params_(std::move(params)) {
+    : bus_(bus), params_(std::move(params)), collector_(params_.truth_channel) {
   if (!params_.camera_channel.empty()) {
     frames_ =
         std::make_unique<RecentCameraFrames>(params_.camera_channel, params_.image_budget_bytes);
   }
-  subscriptions_.push_back(bus_.subscribe(".*", [this](const core::RawMessage& message) {
-    if (frames_ && message.channel == params_.camera_channel) {
-      frames_->add(message.data, message.size);
-      ++version_;
-      return;
-    }
-    take(message);
-  }));
+  subscriptions_.push_back(
+      bus_.subscribe(".*", [this](const core::RawMessage& message) { take(message); }));
+  if (params_.background) drainer_ = std::thread([this] { drain(); });
+}
+
+LiveFeed::~LiveFeed() {
+  stop_ = true;
+  if (drainer_.joinable()) drainer_.join();
+}
+
+void LiveFeed::drain() {
+  try {
+    while (!stop_) bus_.handle(std::chrono::milliseconds(50));
+  } catch (...) {
+    std::lock_guard lock(mutex_);
+    failure_ = std::current_exception();
+  }
 }
 
 void LiveFeed::take(const core::RawMessage& message) {
+  std::lock_guard lock(mutex_);
+  ++taken_;
+  if (frames_ && message.channel == params_.camera_channel) {
+    frames_->add(message.data, message.size);
+    ++version_;
+    return;
+  }
   const bool truth = params_.truth_channel.empty()
                          ? msg::isType<msg::Pose>(message.data, message.size)
                          : message.channel == params_.truth_channel;
@@ -47,13 +64,45 @@ void LiveFeed::restart() {
   ++restarts_;
 }
 
-int LiveFeed::poll() { return bus_.handleAvailable(); }
+int LiveFeed::poll() {
+  if (!params_.background) bus_.handleAvailable();
+  {
+    std::lock_guard lock(mutex_);
+    if (failure_) std::rethrow_exception(failure_);
+  }
+  return taken_.exchange(0);
+}
+
+int LiveFeed::restarts() const {
+  std::lock_guard lock(mutex_);
+  return restarts_;
+}
 
 std::optional<RunData> LiveFeed::run(const std::string& name) const {
-  if (collector_.truthPoses() == 0) return std::nullopt;
-  RunData run = runFromPoses(name, collector_.trajectories());
+  logs::LogTrajectories recorded;
+  {
+    std::lock_guard lock(mutex_);
+    if (collector_.truthPoses() == 0) return std::nullopt;
+    recorded = collector_.trajectories();
+  }
+  RunData run = runFromPoses(name, recorded);
   run.poses_from = "the bus";
   return run;
+}
+
+std::optional<CameraFrame> LiveFeed::LockedFrames::frameAt(double t_s) {
+  std::lock_guard lock(feed_.mutex_);
+  return feed_.frames_->frameAt(t_s);
+}
+
+std::size_t LiveFeed::LockedFrames::count() const {
+  std::lock_guard lock(feed_.mutex_);
+  return feed_.frames_->count();
+}
+
+std::string LiveFeed::LockedFrames::describe() const {
+  std::lock_guard lock(feed_.mutex_);
+  return feed_.frames_->describe();
 }
 
 }  // namespace nadir::gui

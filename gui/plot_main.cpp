@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
       try {
         bus = nadir::core::openBus(url);
         nadir::gui::LiveFeedParams params;
+        params.background = true;
         params.camera_channel.clear();  // plots need no images
         feed = std::make_unique<nadir::gui::LiveFeed>(*bus, params);
       } catch (const std::exception& error) {

@@ -17,4 +17,11 @@ namespace nadir::gui {
 void screenshotAfter(QWidget& window, double wait_s, const std::string& png_path,
                      const std::string& program, std::function<void()> report = {});
 
+// The same, as soon as ready() holds (asked every 100 ms), and after wait_s at
+// the most: a script waits for a condition, not for a time a loaded machine
+// may not keep.
+void screenshotWhen(QWidget& window, std::function<bool()> ready, double wait_s,
+                    const std::string& png_path, const std::string& program,
+                    std::function<void()> report = {});
+
 }  // namespace nadir::gui

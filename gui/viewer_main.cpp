@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
                  "save the window to this PNG after --wait, print what it shows and exit");
   app.add_option("--wait", wait_s, "seconds before --screenshot (live: of listening)")
       ->check(CLI::NonNegativeNumber);
+  std::size_t until_truth_poses = 0;
+  app.add_option("--until-truth-poses", until_truth_poses,
+                 "with --live and --screenshot: take it once the live run holds this many truth "
+                 "poses (--wait is then the most to wait)");
   CLI11_PARSE(app, argc, argv);
   if (!live && paths.empty()) {
     std::fprintf(stderr, "nadir-viewer: give a run folder or log, or --live (see --help)\n");
@@ -83,8 +87,12 @@ int main(int argc, char** argv) {
       bus_params.recv_buf_size_bytes = recv_buf_bytes;
       bus = nadir::core::openBus(bus_params);
       nadir::gui::LiveFeedParams params;
+      params.background = true;
       params.camera_channel = camera_channel;
       feed = std::make_unique<nadir::gui::LiveFeed>(*bus, params);
+      // Scripts start sending once this is printed.
+      std::printf("nadir-viewer: listening on %s\n", bus->url().c_str());
+      std::fflush(stdout);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nadir-viewer: %s\n", e.what());
@@ -100,7 +108,7 @@ int main(int argc, char** argv) {
   if (!live) window.seek(at_s);
   if (!screenshot.empty()) {
     // What was shown, for scripts: each run's poses, the time and the image.
-    nadir::gui::screenshotAfter(window, wait_s, screenshot, "nadir-viewer", [&window] {
+    const auto report = [&window] {
       for (const nadir::gui::RunData& run : window.runs()) {
         std::printf("run %s: %zu truth poses", run.dir.c_str(), run.truth.size());
         for (const auto& [name, source] : run.sources) {
@@ -110,7 +118,18 @@ int main(int argc, char** argv) {
       }
       std::printf("time %s\ncamera %s\n", window.timeText().toStdString().c_str(),
                   window.cameraCaption().toStdString().c_str());
-    });
+    };
+    if (live && until_truth_poses > 0) {
+      const auto enough = [&window, until_truth_poses] {
+        for (const nadir::gui::RunData& run : window.runs()) {
+          if (run.dir == "live" && run.truth.size() >= until_truth_poses) return true;
+        }
+        return false;
+      };
+      nadir::gui::screenshotWhen(window, enough, wait_s, screenshot, "nadir-viewer", report);
+    } else {
+      nadir::gui::screenshotAfter(window, wait_s, screenshot, "nadir-viewer", report);
+    }
   }
   return QApplication::exec();
 }

@@ -511,7 +511,13 @@ Bytes encode(const Heartbeat& message) {
   out.node = message.node;
   out.pid = message.pid;
   out.sequence = message.sequence;
+  out.done = message.done;
   out.summary = message.summary;
+  for (const auto& [channel, count] : message.sent) {
+    out.channels.push_back(channel);
+    out.messages_sent.push_back(count);
+  }
+  out.num_channels = static_cast<std::int32_t>(out.channels.size());
   return toBytes(out);
 }
 
@@ -710,7 +716,10 @@ VoCommand decode<VoCommand>(const void* data, std::size_t size) {
 template <>
 Heartbeat decode<Heartbeat>(const void* data, std::size_t size) {
   const auto in = fromBytes<nadir::heartbeat_t>(data, size);
-  return {in.utime, in.node, in.pid, in.sequence, in.summary};
+  Heartbeat out{in.utime, in.node, in.pid, in.sequence, in.done != 0, in.summary, {}};
+  for (std::size_t i = 0; i < in.channels.size(); ++i)
+    out.sent[in.channels[i]] = in.messages_sent[i];
+  return out;
 }
 
 // ---------------------------------------------------------------- types

@@ -6,6 +6,7 @@
 // image is in lcmtypes/image.h (it holds OpenCV pixels).
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -191,8 +192,10 @@ struct Heartbeat {
   std::int64_t utime = 0;  // wall clock, us since the Unix epoch
   std::string node;        // the registry name: sim, camera, ppa, vo_feature, ...
   std::int32_t pid = 0;
-  std::int64_t sequence = 0;  // 0 for the first, then one more each time
-  std::string summary;        // what the node has done so far, one line
+  std::int64_t sequence = 0;                 // 0 for the first, then one more each time
+  bool done = false;                         // the last one, as the node stops
+  std::string summary;                       // what the node has done so far, one line
+  std::map<std::string, std::int64_t> sent;  // messages published so far, by channel
 };
 
 }  // namespace nadir::msg

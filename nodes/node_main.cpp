@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "core/clock.h"
@@ -48,7 +49,8 @@ void listScenarios() {
   }
 }
 
-// Sends the node's heartbeat now and then once a second of wall time.
+// Sends the node's heartbeat now, then once a second of wall time, and a last
+// one as it stops: what it has done and everything it has published.
 class Heartbeat {
  public:
   Heartbeat(core::Bus& bus, std::string channel, std::string node)
@@ -57,14 +59,22 @@ class Heartbeat {
   void beatIfDue(const Node& running) {
     const auto now = std::chrono::steady_clock::now();
     if (sequence_ > 0 && now - last_ < std::chrono::seconds(1)) return;
-    last_ = now;
+    beat(running, false);
+  }
+
+  void last(const Node& running) { beat(running, true); }
+
+ private:
+  void beat(const Node& running, bool done) {
+    last_ = std::chrono::steady_clock::now();
+    std::map<std::string, std::int64_t> sent = bus_.sent();
+    sent.erase(channel_);  // its own heartbeats are not the node's output
     msg::publish(
         bus_, channel_,
         msg::Heartbeat{core::wallClockUtime(), node_, static_cast<std::int32_t>(::getpid()),
-                       sequence_++, running.summary()});
+                       sequence_++, done, running.summary(), std::move(sent)});
   }
 
- private:
   core::Bus& bus_;
   std::string channel_;
   std::string node_;
@@ -129,6 +139,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
       if (live) heartbeat.beatIfDue(*node);
       working = node->turn(*bus);
     }
+    if (live) heartbeat.last(*node);
     std::cout << info.program << ": " << (g_stop ? "stopped" : "done") << "; " << node->summary()
               << std::endl;
   } catch (const std::exception& error) {

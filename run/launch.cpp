@@ -17,6 +17,7 @@
 
 #include "core/bus.h"
 #include "core/clock.h"
+#include "core/lcm_log.h"
 #include "lcmtypes/codec.h"
 #include "lcmtypes/messages.h"
 #include "nodes/registry.h"
@@ -31,6 +32,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+// How long the end of a launch waits for the nodes to finish their work and for
+// the recording to hold it, at most.
+constexpr auto kSettleLimit = std::chrono::seconds(120);
 
 std::string programPath(const std::string& bin_dir, const std::string& name) {
   const fs::path path = fs::path(bin_dir) / name;
@@ -56,6 +61,59 @@ struct ChannelHealth {
   }
 };
 
+// The recording's messages by channel, read as lcm-logger writes it: each
+// update() reads only what was appended since the last.
+class RecordingCounter {
+ public:
+  explicit RecordingCounter(std::string path) : path_(std::move(path)) {}
+
+  void update() {
+    std::error_code error;
+    const auto size = fs::file_size(path_, error);
+    if (error || size <= static_cast<std::uintmax_t>(resume_offset_)) return;
+    try {
+      core::LcmLogReader reader(path_);
+      if (resume_offset_ > 0) reader.seek(resume_offset_);
+      while (const auto event = reader.next()) {
+        ++counts_[event->channel];
+        resume_offset_ = reader.tell();
+      }
+    } catch (const core::LogError&) {
+      // Not one whole event written yet: the next update reads it.
+    }
+  }
+  std::int64_t count(const std::string& channel) const {
+    const auto it = counts_.find(channel);
+    return it == counts_.end() ? 0 : it->second;
+  }
+
+ private:
+  std::string path_;
+  std::int64_t resume_offset_ = 0;
+  std::map<std::string, std::int64_t> counts_;
+};
+
+// What a node's heartbeats say: its summary, what it has sent, whether that
+// changed since the heartbeat before (it is still at work) and whether it is done.
+struct NodeReport {
+  std::string summary;
+  std::map<std::string, std::int64_t> sent;
+  bool working = true;
+  bool done = false;
+};
+
+// Channels whose messages the recording holds fewer of than the nodes sent.
+std::map<std::string, std::pair<std::int64_t, std::int64_t>> missingFromRecording(
+    const std::map<std::string, NodeReport>& reports, const RecordingCounter& recording) {
+  std::map<std::string, std::pair<std::int64_t, std::int64_t>> missing;  // sent, recorded
+  for (const auto& [node, report] : reports) {
+    for (const auto& [channel, sent] : report.sent) {
+      if (recording.count(channel) < sent) missing[channel] = {sent, recording.count(channel)};
+    }
+  }
+  return missing;
+}
+
 struct LaunchedNode {
   const nodes::Entry* entry = nullptr;
   std::unique_ptr<ChildProcess> process;
@@ -65,7 +123,7 @@ struct LaunchedNode {
 // produce, the VO nodes' status, and what each node's heartbeat says.
 void printHealth(std::ostream& out, double elapsed_s, double window_s, double speed,
                  std::map<std::string, ChannelHealth>& channels,
-                 const std::map<std::string, std::string>& heartbeats) {
+                 const std::map<std::string, NodeReport>& heartbeats) {
   char line[256];
   std::snprintf(line, sizeof(line), "launch: %.0f s", elapsed_s);
   out << line << "\n";
@@ -85,7 +143,9 @@ void printHealth(std::ostream& out, double elapsed_s, double window_s, double sp
     out << "\n";
     health.window = 0;
   }
-  for (const auto& [node, summary] : heartbeats) out << "  " << node << ": " << summary << "\n";
+  for (const auto& [node, report] : heartbeats) {
+    out << "  " << node << ": " << report.summary << "\n";
+  }
   out.flush();
 }
 
@@ -108,8 +168,8 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
           ? (fs::path("out") / (fs::path(options.scenario).stem().string() + "-live")).string()
           : options.out_dir;
   const fs::path out_path(out_dir);
-  const fs::path recording = out_path / "launch.lcmlog";
-  if (!options.force && fs::exists(recording)) {
+  const fs::path recording_path = out_path / "launch.lcmlog";
+  if (!options.force && fs::exists(recording_path)) {
     throw std::runtime_error(out_dir +
                              " already holds a launch (launch.lcmlog); choose another "
                              "--out or pass --force to replace it");
@@ -125,8 +185,10 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // One process per node the scenario runs, each given the scenario and overrides;
   // the simulator starts once the others are up, and the health report expects
   // what the nodes' streams say.
-  ChildProcess logger("lcm-logger", {"lcm-logger", "--lcm-url=" + url, "-f", recording.string()},
+  ChildProcess logger("lcm-logger",
+                      {"lcm-logger", "--lcm-url=" + url, "-f", recording_path.string()},
                       nodeLog("lcm-logger"));
+  RecordingCounter recording(recording_path.string());
   std::vector<LaunchedNode> launched;
   std::map<std::string, ChannelHealth> channels;
   for (const auto& entry : nodes::registry()) {
@@ -156,12 +218,16 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // Health: what arrives on the bus, against what the scenario should produce;
   // the nodes' heartbeats say they are up and what they have done.
   auto bus = core::openBus(scenario.bus);
-  std::map<std::string, std::string> heartbeats;  // node name -> its last summary
+  std::map<std::string, NodeReport> heartbeats;  // by node name
   auto subscription = bus->subscribe(".*", [&](const core::RawMessage& raw) {
     if (raw.channel == scenario.bus.heartbeat_channel) {
       try {
         const msg::Heartbeat beat = msg::decode<msg::Heartbeat>(raw.data, raw.size);
-        heartbeats[beat.node] = beat.summary;
+        NodeReport& report = heartbeats[beat.node];
+        report.working = beat.sent != report.sent;
+        report.sent = beat.sent;
+        report.summary = beat.summary;
+        report.done = report.done || beat.done;
       } catch (const std::exception&) {
       }
       return;
@@ -239,9 +305,21 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
           break;
         }
         out << "launch: the scenario has ended\n";
-        // Let the last frames and estimates arrive and be recorded.
-        const auto tail_end = Clock::now() + std::chrono::seconds(2);
-        while (Clock::now() < tail_end) bus->handle(std::chrono::milliseconds(50));
+        // The nodes finish what they have (a VO behind by some frames), then the
+        // recording must hold all they sent: waited for, not timed.
+        const auto settle_deadline = Clock::now() + kSettleLimit;
+        const auto settled = [&] {
+          recording.update();
+          for (const LaunchedNode& node : launched) {
+            const auto report = heartbeats.find(node.entry->info().name);
+            if (report == heartbeats.end()) return false;
+            if (isSimulator(node) ? !report->second.done : report->second.working) return false;
+          }
+          return missingFromRecording(heartbeats, recording).empty();
+        };
+        while (!stop && !settled() && Clock::now() < settle_deadline) {
+          bus->handle(std::chrono::milliseconds(100));
+        }
         stopAll();
         break;
       }
@@ -262,6 +340,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         last_report = now;
         printHealth(out, std::chrono::duration<double>(now - started).count(), window_s,
                     scenario.time.speed, channels, heartbeats);
+        recording.update();
       }
     }
   } catch (...) {
@@ -283,9 +362,19 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     if (health.expected_hz > 0.0) out << " (" << health.missing() << " missing)";
     out << "\n";
   }
-  out << "launch: recording " << recording.string() << "\n";
+  recording.update();
+  const auto missing = missingFromRecording(heartbeats, recording);
+  for (const auto& [channel, counts] : missing) {
+    out << "launch: the recording holds " << counts.second << " of the " << counts.first << " "
+        << channel << " messages sent\n";
+  }
+  if (missing.empty() && !heartbeats.empty()) {
+    out << "launch: the recording holds every message the nodes said they sent\n";
+  }
+  out << "launch: recording " << recording_path.string() << "\n";
   // Every run has its charts, a launch's too (a stopped one's as far as it went).
-  const RunPlots plots = renderRunPlots(recording.string(), (out_path / "plots").string(), bin_dir);
+  const RunPlots plots =
+      renderRunPlots(recording_path.string(), (out_path / "plots").string(), bin_dir);
   if (plots.problem.empty()) {
     out << "launch: charts in " << (out_path / "plots").string() << "\n";
   } else {

@@ -349,12 +349,20 @@ TEST(Codec, WrongTypeIsADecodeError) {
 
 // A heartbeat and a VO command come back whole.
 TEST(Codec, HeartbeatAndCommandRoundTrip) {
-  const Heartbeat beat{1'700'000'000'000'000, "ppa", 4242, 7, "812 frames"};
+  const Heartbeat beat{1'700'000'000'000'000,
+                       "ppa",
+                       4242,
+                       7,
+                       true,
+                       "812 frames",
+                       {{"POSE_PPA", 812}, {"PPA_ODOMETRY", 812}}};
   const Heartbeat back = decode<Heartbeat>(encode(beat));
   EXPECT_EQ(back.node, "ppa");
   EXPECT_EQ(back.pid, 4242);
   EXPECT_EQ(back.sequence, 7);
+  EXPECT_TRUE(back.done);
   EXPECT_EQ(back.summary, "812 frames");
+  EXPECT_EQ(back.sent, beat.sent);
 
   VoCommand command;
   command.utime = 5;

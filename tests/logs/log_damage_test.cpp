@@ -43,7 +43,7 @@ class RecordingBus final : public core::Bus {
  public:
   std::vector<std::int64_t> times;
   std::string url() const override { return "recording://"; }
-  void publish(std::string_view, const void*, std::size_t, std::int64_t utime) override {
+  void send(std::string_view, const void*, std::size_t, std::int64_t utime) override {
     times.push_back((utime - kT0) / 100'000);
   }
   bool handle(std::chrono::milliseconds) override { return false; }

@@ -47,7 +47,7 @@ class RecordingBus final : public core::Bus {
  public:
   std::vector<Sent> sent;
   std::string url() const override { return "recording://"; }
-  void publish(std::string_view channel, const void*, std::size_t, std::int64_t utime) override {
+  void send(std::string_view channel, const void*, std::size_t, std::int64_t utime) override {
     sent.push_back({std::string(channel), static_cast<double>(utime - kT0) / 1e6});
   }
   bool handle(std::chrono::milliseconds) override { return false; }

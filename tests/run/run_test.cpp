@@ -303,11 +303,18 @@ TEST(Launch, FliesAndStopsCleanly) {
   }
   EXPECT_EQ(status, 0) << out.str();
   EXPECT_NE(out.str().find("the scenario has ended"), std::string::npos) << out.str();
+  // What arrived is what was sent: the nodes' last heartbeats against the recording
+  // (launch waits for it, however loaded the machine), and the simulator's 2 s at
+  // 400 Hz from 0 s, ends included.
+  EXPECT_NE(out.str().find("the recording holds every message the nodes said they sent"),
+            std::string::npos)
+      << out.str();
   std::map<std::string, int> counts;
   core::LcmLogReader reader(recording);
   while (auto event = reader.next()) ++counts[event->channel];
-  EXPECT_GE(counts["POSE_TRUTH"], 2 * 400) << out.str();
-  EXPECT_GE(counts["CAMERA_DOWN"], 2 * 20) << out.str();
+  EXPECT_EQ(counts["POSE_TRUTH"], 2 * 400 + 1) << out.str();
+  EXPECT_GT(counts["CAMERA_DOWN"], 0) << out.str();
+  EXPECT_GT(counts["NADIR_HEARTBEAT"], 0) << out.str();
   // Beside the recording: the effective scenario (the viewers' terrain) and the charts.
   const nodes::ScenarioParams written =
       nodes::loadScenario((fs::path(dir) / "scenario.yaml").string());

@@ -69,12 +69,44 @@ pid_t spawn(const std::vector<std::string>& args) {
   return pid;
 }
 
+// Messages on channel in the log at path so far (0 while it holds no whole event).
+int recorded(const std::string& path, const std::string& channel) {
+  try {
+    int count = 0;
+    nadir::core::LcmLogReader reader(path);
+    while (auto event = reader.next()) count += event->channel == channel ? 1 : 0;
+    return count;
+  } catch (const nadir::core::LogError&) {
+    return 0;
+  }
+}
+
+// Waits until the log at path holds `sent` messages on channel, or has taken none
+// for 5 s (a logger drops what overflows its queue), within 120 s: on what was
+// recorded, not on how long a loaded machine takes to record it.
+void waitUntilRecorded(const std::string& path, const std::string& channel, int sent) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  int last = -1;
+  auto last_change = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() < deadline) {
+    const int now = recorded(path, channel);
+    if (now >= sent) return;
+    if (now != last) {
+      last = now;
+      last_change = std::chrono::steady_clock::now();
+    } else if (std::chrono::steady_clock::now() - last_change > std::chrono::seconds(5)) {
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+}
+
 // Publishes probe messages until the lcm-logger writing path has recorded one (it is
-// subscribed), or 10 s have passed. The probes are on their own channel.
+// subscribed), or 60 s have passed. The probes are on their own channel.
 bool waitForLogger(const std::string& url, const std::string& path) {
   auto bus = nadir::core::openBus(url);
   const std::uint8_t probe[16] = {};
-  for (int i = 0; i < 100; ++i) {
+  for (int i = 0; i < 600; ++i) {
     bus->publish("NADIR_TEST_PROBE", probe, sizeof(probe), 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     std::error_code error;
@@ -141,7 +173,7 @@ TEST(SimNode, LcmLoggerRecordsAndLcmLogplayerReplays) {
       run(std::string(NADIR_SIM_BIN) +
           " default --set duration_s=4 --set time.speed=4 --set sensors.imu.enabled=false" +
           " --set 'bus.url=" + url + "'");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  waitUntilRecorded(first, "POSE_TRUTH", 4 * 400 + 1);
   kill(logger, SIGINT);
   waitpid(logger, nullptr, 0);
   ASSERT_EQ(status, 0) << output;
@@ -162,7 +194,7 @@ TEST(SimNode, LcmLoggerRecordsAndLcmLogplayerReplays) {
   const auto [play_status, play_output] =
       // At the recorded pace: the live run's rate, which the loggers kept up with.
       run("lcm-logplayer --speed=1 --lcm-url='" + url + "' " + first);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  waitUntilRecorded(second, "POSE_TRUTH", readLog(first).counts.at("POSE_TRUTH"));
   kill(relogger, SIGINT);
   waitpid(relogger, nullptr, 0);
   ASSERT_EQ(play_status, 0) << play_output;
