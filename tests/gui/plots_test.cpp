@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -82,6 +84,28 @@ TEST_F(GuiPlots, HeadlessRenderingWritesNonBlankPngsOfTheRightSize) {
   for (const char* name : {"position", "attitude", "error", "top_view"}) {
     EXPECT_TRUE(fs::exists(out / (std::string(name) + ".png"))) << name;
   }
+}
+
+// A source keeps its colour whatever the run's other sources, two sources of one
+// run never share one, and none is the truth's black.
+TEST_F(GuiPlots, EachSourceKeepsItsColour) {
+  RunData alone, together, crowd;
+  alone.sources["vo_feature"];
+  together.sources["vo_feature"];
+  together.sources["ppa"];
+  together.sources["vo_direct"];
+  EXPECT_EQ(sourceColor(alone, "vo_feature"), sourceColor(together, "vo_feature"));
+  for (int i = 0; i < 8; ++i) crowd.sources["source_" + std::to_string(i)];
+  std::set<QRgb> colours;
+  for (const auto& [name, series] : crowd.sources) {
+    const QColor colour = sourceColor(crowd, name);
+    EXPECT_NE(colour, QColor(Qt::black)) << name;
+    colours.insert(colour.rgb());
+  }
+  EXPECT_EQ(colours.size(), crowd.sources.size());
+  EXPECT_NE(sourceColor(together, "ppa"), sourceColor(together, "vo_feature"));
+  EXPECT_NE(sourceColor(together, "ppa"), sourceColor(together, "vo_direct"));
+  EXPECT_NE(sourceColor(together, "vo_feature"), sourceColor(together, "vo_direct"));
 }
 
 TEST_F(GuiPlots, TopViewHasTheSameScaleOnBothAxes) {

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <thread>
@@ -140,6 +141,29 @@ TEST(SimNode, BatchRunWritesTheStreamsToALog) {
   }
   // 5 m above the start's ground, which is the world origin's plane plus its relief.
   EXPECT_LT(contents.poses.front().pos[2], 0.0);
+}
+
+// The node's own parameter file instead of a scenario (--config): the simulator's
+// keys at the top level, world, time and bus; --set overrides its keys.
+TEST(SimNode, ConfigFileInsteadOfAScenario) {
+  const std::string log = tempPath("config.lcmlog");
+  const std::string config = tempPath("sim.yaml");
+  std::filesystem::remove(log);
+  std::ofstream(config) << "duration_s: 1\n"
+                           "route:\n  waypoints: [[300, 0], [300, 300]]\n"
+                           "time:\n  mode: batch\n"
+                           "bus:\n  url: \"file://" +
+                               log + "?mode=w\"\n";
+  const auto [status, output] =
+      run(std::string(NADIR_SIM_BIN) + " --config " + config + " --set truth.rate_hz=200");
+  ASSERT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("nadir-sim parameters (" + config + ")"), std::string::npos) << output;
+  EXPECT_EQ(readLog(log).counts.at("POSE_TRUTH"), 201);  // 1 s at 200 Hz, ends included
+  // A key the simulator does not have is refused, naming the file.
+  std::ofstream(config, std::ios::app) << "nonsense: 3\n";
+  const auto [bad_status, bad_output] = run(std::string(NADIR_SIM_BIN) + " --config " + config);
+  EXPECT_EQ(bad_status, 1);
+  EXPECT_NE(bad_output.find("nonsense: unknown key"), std::string::npos) << bad_output;
 }
 
 // A bad override stops the program before it publishes anything, naming the key.
