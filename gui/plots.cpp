@@ -358,7 +358,9 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
   ChartBuilder chart("Position error: " + runName(run), "time (s)", "|p_est - p_truth| (m)");
   for (const auto& [source, series] : run.sources) {
     if (hidden.contains(source)) continue;
-    const std::vector<double> t = sinceStart(figureColumns(series).t_s, run.t0_s);
+    std::vector<double> t;
+    for (const logs::SourceEstimate& estimate : series.estimates)
+      t.push_back(estimate.t_s - run.t0_s);
     chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
                   series.position_error_m);
   }

@@ -13,6 +13,7 @@
 
 #include "core/bus.h"
 #include "core/params.h"
+#include "logs/run_log.h"
 
 namespace nadir::terrain {
 class World;
@@ -47,8 +48,9 @@ struct Stream {
 // What a node may add to a batch run's results (the PPA's target passes).
 struct BatchReportInput {
   const ScenarioParams& scenario;
-  std::string log_path;  // the run's recording
-  std::string out_dir;   // where the run's files go
+  std::string log_path;                   // the run's recording
+  const logs::LogTrajectories& recorded;  // its truth and estimates, as evaluated
+  std::string out_dir;                    // where the run's files go
   const terrain::World& world;
 };
 

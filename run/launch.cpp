@@ -7,13 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include "core/bus.h"
 #include "core/clock.h"

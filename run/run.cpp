@@ -61,11 +61,12 @@ RunResult runScenario(const RunOptions& options,
   result.metrics_path = (out / kMetricsName).string();
   writeEffectiveScenario(result.out_dir, "nadir run " + options.scenario, scenario);
 
-  // The processing nodes the scenario runs, with their parameters.
-  std::vector<std::pair<const nodes::Entry*, core::AnyParams>> processing;
+  // The nodes the scenario runs besides the simulator, with their parameters:
+  // the camera, then the processing nodes.
+  std::vector<std::pair<const nodes::Entry*, core::AnyParams>> running_nodes;
   for (const auto& entry : nodes::registry()) {
-    if (entry->info().role == nodes::EntryInfo::Role::kProcessing && entry->enabled(scenario)) {
-      processing.emplace_back(entry.get(), entry->fromScenario(scenario));
+    if (entry->info().role != nodes::EntryInfo::Role::kSimulator && entry->enabled(scenario)) {
+      running_nodes.emplace_back(entry.get(), entry->fromScenario(scenario));
     }
   }
 
@@ -74,9 +75,8 @@ RunResult runScenario(const RunOptions& options,
   // Every message is recorded at its own (sim) time, images unless left out.
   std::set<std::string> unrecorded;
   if (!options.record_images) {
-    for (const auto& entry : nodes::registry()) {
-      if (entry->info().role == nodes::EntryInfo::Role::kSimulator) continue;
-      for (const nodes::Stream& stream : entry->streams(entry->fromScenario(scenario))) {
+    for (const auto& [entry, params] : running_nodes) {
+      for (const nodes::Stream& stream : entry->streams(params)) {
         if (stream.bulky) unrecorded.insert(stream.channel);
       }
     }
@@ -91,9 +91,10 @@ RunResult runScenario(const RunOptions& options,
 
   // The simulator and the camera make the world (the camera's world serves both);
   // the processing nodes come from the registry.
-  const nodes::Entry& camera_entry = nodes::entry("camera");
-  camera::CameraNode camera(*bus,
-                            camera_entry.fromScenario(scenario).as<camera::CameraNodeParams>());
+  const auto camera_params = std::find_if(
+      running_nodes.begin(), running_nodes.end(),
+      [](const auto& node) { return node.first->info().role == nodes::EntryInfo::Role::kCamera; });
+  camera::CameraNode camera(*bus, camera_params->second.as<camera::CameraNodeParams>());
   // The main camera's last image, for a picture of what it saw.
   cv::Mat last_image;
   core::Subscription last_image_keeper = msg::subscribe<msg::Image>(
@@ -104,7 +105,11 @@ RunResult runScenario(const RunOptions& options,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
   std::vector<std::unique_ptr<nodes::Node>> running;
-  for (const auto& [entry, params] : processing) running.push_back(entry->start(*bus, params));
+  for (const auto& [entry, params] : running_nodes) {
+    if (entry->info().role == nodes::EntryInfo::Role::kProcessing) {
+      running.push_back(entry->start(*bus, params));
+    }
+  }
 
   const auto wall_start = std::chrono::steady_clock::now();
   auto last_report = wall_start;
@@ -145,9 +150,9 @@ RunResult runScenario(const RunOptions& options,
     cv::imwrite(result.picture_paths.back(), last_image);
   }
   result.table = eval::formatResultsTable(result.metrics);
-  const nodes::BatchReportInput report_input{scenario, result.log_path, result.out_dir,
-                                             *camera.scene().built.world};
-  for (const auto& [entry, params] : processing) {
+  const nodes::BatchReportInput report_input{scenario, result.log_path, evaluation.recorded,
+                                             result.out_dir, *camera.scene().built.world};
+  for (const auto& [entry, params] : running_nodes) {
     const std::string section = entry->batchReport(report_input, params);
     if (!section.empty()) result.table += "\n" + section;
   }

@@ -106,8 +106,7 @@ class PpaEntry final : public TypedEntry<PpaProcessParams> {
   // around them (target_passes.csv beside the run).
   std::string report(const BatchReportInput& input, const PpaProcessParams& params) const override {
     if (!params.node.target_extraction || params.known_targets_ne_m.empty()) return {};
-    const logs::LogTrajectories recorded =
-        logs::readRunLog(input.log_path, input.scenario.sim.truth.channel);
+    const logs::LogTrajectories& recorded = input.recorded;
     if (recorded.sources.count(info().name) == 0) return {};
     ppa::TargetPassInput passes;
     passes.truth = recorded.truth;
