@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/params.h"
+#include "nodes/common/vo_frame.h"
 #include "nodes/vo_feature/bundle_adjustment.h"
 #include "nodes/vo_feature/debug_image.h"
 #include "nodes/vo_feature/features.h"
@@ -75,20 +76,6 @@ struct FeatureVoParams {
 
   void visit(core::ParamVisitor& v);
 };
-
-struct VoFrameInput {
-  std::int64_t utime = 0;
-  cv::Mat gray;  // 8-bit, undistorted
-  cv::Matx33d K = cv::Matx33d::eye();
-  Eigen::Matrix3d R_body_cam = Eigen::Matrix3d::Identity();
-  // The rangefinder, for the metric scale: its range along its ray (a unit
-  // vector in the camera frame), m.
-  std::optional<double> range_m;
-  Eigen::Vector3d range_ray_cam = Eigen::Vector3d::UnitZ();
-  std::optional<Eigen::Quaterniond> q_world_body_prior;  // optional attitude prior
-};
-
-enum class VoStatus { kInitializing, kTracking, kLost };
 
 // Wall-clock seconds spent in each stage, summed over the frames processed
 // (diagnostics only: nothing the VO computes depends on them).
