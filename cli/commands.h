@@ -25,6 +25,7 @@ void addLaunchCommand(CLI::App& app);
 void addSweepCommand(CLI::App& app);
 void addLogCommands(CLI::App& app);
 void addEvalCommand(CLI::App& app);
+void addVoCommands(CLI::App& app);
 
 // nadir run's and nadir demo's progress line, on stderr, and its end.
 void printRunProgress(const run::RunProgress& progress);

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   nadir::cli::addSweepCommand(app);
   nadir::cli::addLogCommands(app);
   nadir::cli::addEvalCommand(app);
+  nadir::cli::addVoCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

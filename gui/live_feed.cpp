@@ -50,8 +50,21 @@ void LiveFeed::take(const core::RawMessage& message) {
       if (t_s < newest_truth_s_ - kRestartJump_s) restart();
       newest_truth_s_ = std::max(newest_truth_s_, t_s);
     }
+    keepNewestTruth(message);
   }
   if (collector_.add(std::string(message.channel), message.data, message.size)) ++version_;
+}
+
+void LiveFeed::keepNewestTruth(const core::RawMessage& message) {
+  msg::Pose pose;
+  try {
+    pose = msg::decode<msg::Pose>(message.data, message.size);
+  } catch (const std::exception&) {
+    return;  // the collector counts it
+  }
+  if (newest_truth_ && pose.utime < newest_truth_->utime) return;
+  newest_truth_ = pose;
+  newest_truth_received_ = std::chrono::steady_clock::now();
 }
 
 void LiveFeed::restart() {
@@ -61,6 +74,7 @@ void LiveFeed::restart() {
         std::make_unique<RecentCameraFrames>(params_.camera_channel, params_.image_budget_bytes);
   }
   newest_truth_s_ = -1e300;
+  newest_truth_.reset();
   ++restarts_;
 }
 
@@ -76,6 +90,14 @@ int LiveFeed::poll() {
 int LiveFeed::restarts() const {
   std::lock_guard lock(mutex_);
   return restarts_;
+}
+
+std::optional<msg::Pose> LiveFeed::liveTruth(std::chrono::milliseconds max_age) const {
+  std::lock_guard lock(mutex_);
+  if (!newest_truth_ || std::chrono::steady_clock::now() - newest_truth_received_ > max_age) {
+    return std::nullopt;
+  }
+  return newest_truth_;
 }
 
 std::optional<RunData> LiveFeed::run(const std::string& name) const {

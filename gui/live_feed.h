@@ -8,6 +8,7 @@
 // (call it often: the windows do from a timer). Nothing here blocks.
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -22,6 +23,7 @@
 #include "core/bus.h"
 #include "gui/camera_frames.h"
 #include "gui/run_data.h"
+#include "lcmtypes/messages.h"
 #include "logs/run_log.h"
 
 namespace nadir::gui {
@@ -64,6 +66,9 @@ class LiveFeed {
   CameraFrames* frames() { return frames_ ? &locked_frames_ : nullptr; }
   // How many times a new run replaced the gathered one.
   int restarts() const;
+  // The newest truth pose if it came at most max_age of wall time ago (the
+  // truth is live); nothing otherwise.
+  std::optional<msg::Pose> liveTruth(std::chrono::milliseconds max_age) const;
 
  private:
   // The images, each call under the feed's lock.
@@ -79,6 +84,7 @@ class LiveFeed {
   };
 
   void take(const core::RawMessage& message);
+  void keepNewestTruth(const core::RawMessage& message);
   void restart();
   void drain();
 
@@ -91,6 +97,8 @@ class LiveFeed {
   std::atomic<std::uint64_t> version_{0};
   std::atomic<int> taken_{0};
   double newest_truth_s_ = -1e300;
+  std::optional<msg::Pose> newest_truth_;
+  std::chrono::steady_clock::time_point newest_truth_received_;
   int restarts_ = 0;
   std::vector<core::Subscription> subscriptions_;
   std::atomic<bool> stop_{false};

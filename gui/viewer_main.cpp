@@ -23,6 +23,7 @@
 #include "gui/screenshot.h"
 #include "gui/trajectory_view.h"
 #include "gui/viewer_window.h"
+#include "gui/vo_reset_sender.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"nadir-viewer: 3D view and playback of runs over the terrain, from logs or live"};
@@ -44,6 +45,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--camera-channel", camera_channel,
                  "image_t channel shown beside the 3D view (live and logs)");
+  std::string command_channel = "VO_COMMAND";
+  app.add_option("--command-channel", command_channel,
+                 "vo_command_t channel of the Reset VO button (--live)")
+      ->capture_default_str();
   double at_s = 0.0;
   double wait_s = 0.5;
   std::string screenshot;
@@ -66,6 +71,7 @@ int main(int argc, char** argv) {
   std::optional<nadir::gui::ViewerTerrain> terrain;
   std::unique_ptr<nadir::core::Bus> bus;
   std::unique_ptr<nadir::gui::LiveFeed> feed;
+  std::unique_ptr<nadir::gui::VoResetSender> reset_sender;
   try {
     for (const std::string& path : paths) {
       runs.push_back(nadir::gui::loadRun(path));
@@ -90,6 +96,7 @@ int main(int argc, char** argv) {
       params.background = true;
       params.camera_channel = camera_channel;
       feed = std::make_unique<nadir::gui::LiveFeed>(*bus, params);
+      reset_sender = std::make_unique<nadir::gui::VoResetSender>(*bus, command_channel);
       // Scripts start sending once this is printed.
       std::printf("nadir-viewer: listening on %s\n", bus->url().c_str());
       std::fflush(stdout);
@@ -104,6 +111,7 @@ int main(int argc, char** argv) {
   nadir::gui::ViewerWindow window(std::move(runs), std::move(terrain));
   if (camera_channel != nadir::gui::kDefaultCameraChannel) window.setCameraChannel(camera_channel);
   if (feed) window.attachLive(*feed, QStringLiteral("live"));
+  if (reset_sender) window.attachVoReset(*reset_sender);
   window.show();
   if (!live) window.seek(at_s);
   if (!screenshot.empty()) {

@@ -17,6 +17,7 @@
 #include <QSlider>
 #include <QSplitter>
 #include <QStatusBar>
+#include <QToolButton>
 #include <QVBoxLayout>
 #include <QWidget>
 
@@ -26,8 +27,10 @@
 #include <filesystem>
 #include <utility>
 
+#include "core/clock.h"
 #include "gui/live_feed.h"
 #include "gui/plots.h"
+#include "gui/vo_reset_sender.h"
 
 namespace nadir::gui {
 namespace {
@@ -178,6 +181,16 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
   controls->addWidget(speed_);
   controls->addWidget(follow_);
   controls->addWidget(live_);
+  reset_ = new QToolButton(central);
+  reset_->setObjectName(QStringLiteral("vo_reset"));
+  reset_->setText(QStringLiteral("Reset VO"));
+  reset_->setToolTip(
+      QStringLiteral("restart every VO node at the newest truth pose (without a live truth: "
+                     "where each estimates now); the menu resets one"));
+  reset_->setPopupMode(QToolButton::MenuButtonPopup);
+  reset_->setMenu(new QMenu(reset_));
+  reset_->setVisible(false);
+  controls->addWidget(reset_);
   layout->addLayout(controls);
   setCentralWidget(central);
   setSpeed(1.0);
@@ -205,6 +218,7 @@ ViewerWindow::ViewerWindow(std::vector<RunData> runs, std::optional<ViewerTerrai
       seek(duration_s_);
     }
   });
+  connect(reset_, &QToolButton::clicked, this, [this] { resetVo({}); });
   connect(camera_run_, &QComboBox::currentIndexChanged, this, [this] {
     if (!showing_time_) showCamera();
   });
@@ -276,8 +290,66 @@ void ViewerWindow::pollLive() {
     if (!view_->cameraMovedByUser()) view_->fitToRuns();
   }
   runsChanged();
+  listResetSources();
   if (first && run) showCameraOf(live_name_.toStdString());
   if (live_->isChecked()) seek(duration_s_);
+}
+
+void ViewerWindow::attachVoReset(VoResetSender& sender) {
+  reset_sender_ = &sender;
+  reset_->setVisible(true);
+  reset_sources_.reset();
+  listResetSources();
+}
+
+void ViewerWindow::listResetSources() {
+  if (reset_sender_ == nullptr) return;
+  std::vector<std::string> sources;
+  for (const RunData& run : runs_) {
+    if (feed_ != nullptr && run.dir == live_name_.toStdString()) {
+      for (const auto& [name, source] : run.sources) sources.push_back(name);
+    }
+  }
+  if (reset_sources_ == sources) return;
+  reset_sources_ = sources;
+  QMenu* menu = reset_->menu();
+  menu->clear();
+  menu->addAction(QStringLiteral("Reset every VO node"), [this] { resetVo({}); });
+  if (!sources.empty()) menu->addSeparator();
+  for (const std::string& source : sources) {
+    menu->addAction(QStringLiteral("Reset %1").arg(QString::fromStdString(source)),
+                    [this, source] { resetVo(source); });
+  }
+}
+
+std::optional<msg::VoCommand> ViewerWindow::resetVo(const std::string& source) {
+  if (reset_sender_ == nullptr) return std::nullopt;
+  const std::optional<msg::Pose> truth =
+      feed_ != nullptr ? feed_->liveTruth(kTruthLiveAge) : std::nullopt;
+  const QString whom =
+      source.empty() ? QStringLiteral("every VO node") : QString::fromStdString(source);
+  msg::VoCommand sent;
+  try {
+    sent = reset_sender_->send(source, truth, core::wallClockUtime());
+  } catch (const std::exception& e) {
+    statusBar()->showMessage(QStringLiteral("reset: the bus failed: %1").arg(e.what()));
+    return std::nullopt;
+  }
+  if (truth) {
+    const Eigen::Vector3d& p = truth->p_ned_m;
+    statusBar()->showMessage(
+        QStringLiteral("sent RESET to %1 on %2 at the truth's pose (N %3 E %4 D %5 m)")
+            .arg(whom, QString::fromStdString(reset_sender_->channel()))
+            .arg(p.x(), 0, 'f', 1)
+            .arg(p.y(), 0, 'f', 1)
+            .arg(p.z(), 0, 'f', 1));
+  } else {
+    statusBar()->showMessage(
+        QStringLiteral("sent RESET to %1 on %2 without a pose (no live truth): each restarts "
+                       "where it estimates now")
+            .arg(whom, QString::fromStdString(reset_sender_->channel())));
+  }
+  return sent;
 }
 
 void ViewerWindow::openRun(const std::string& path) {

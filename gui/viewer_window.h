@@ -3,7 +3,8 @@
 // chosen run's scenario (the first's by default), a chosen run's camera image beside it, and
 // playback synchronised over every run and trajectory (play/pause, seek slider, time readout, speed
 // 0.1x to 20x, follow the vehicle). Runs come from run folders and LCM logs (File menu or the
-// constructor) or, in live mode, from a LiveFeed on a bus.
+// constructor) or, in live mode, from a LiveFeed on a bus, where a Reset button restarts the VO
+// nodes.
 
 #include <QElapsedTimer>
 #include <QImage>
@@ -11,6 +12,7 @@
 #include <QString>
 #include <QTimer>
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <optional>
@@ -21,6 +23,7 @@
 #include "gui/camera_frames.h"
 #include "gui/run_data.h"
 #include "gui/trajectory_view.h"
+#include "lcmtypes/messages.h"
 
 class QCheckBox;
 class QComboBox;
@@ -29,10 +32,12 @@ class QLabel;
 class QMenu;
 class QPushButton;
 class QSlider;
+class QToolButton;
 
 namespace nadir::gui {
 
 class LiveFeed;
+class VoResetSender;
 
 class ViewerWindow : public QMainWindow {
  public:
@@ -49,6 +54,17 @@ class ViewerWindow : public QMainWindow {
   // timer calls it).
   void pollLive();
   bool followingLive() const;
+
+  // The truth is live while its newest pose is at most this old (wall time).
+  static constexpr std::chrono::milliseconds kTruthLiveAge{2000};
+  // Live mode: the Reset button (and its menu of the sources seen) sends RESETs
+  // through sender, which must outlive the window.
+  void attachVoReset(VoResetSender& sender);
+  // What the Reset button does: a RESET to `source` (empty: every VO node), to
+  // the newest truth pose while the truth is live, else without a pose (each
+  // node restarts where it estimates now). Returns what was sent; nothing
+  // without a sender or when the bus failed (the status bar says why).
+  std::optional<msg::VoCommand> resetVo(const std::string& source);
 
   // Opens a run folder or an LCM log and adds it to the runs; the terrain is
   // taken from its scenario.yaml if the window has none yet. Throws RunDataError.
@@ -94,6 +110,7 @@ class ViewerWindow : public QMainWindow {
   void showTime();
   void showCamera();
   void runsChanged();
+  void listResetSources();
   void openDialog(bool log_file);
   const RunData* cameraRun() const;
   // The run's scenario.yaml; empty for the live run and a run without one.
@@ -115,6 +132,10 @@ class ViewerWindow : public QMainWindow {
   QComboBox* speed_ = nullptr;
   QCheckBox* follow_ = nullptr;
   QCheckBox* live_ = nullptr;
+  QToolButton* reset_ = nullptr;
+  VoResetSender* reset_sender_ = nullptr;
+  // The sources in the Reset button's menu; nothing before it is made.
+  std::optional<std::vector<std::string>> reset_sources_;
   QTimer timer_;
   QTimer live_timer_;
   QElapsedTimer clock_;

@@ -183,7 +183,8 @@ struct VoCommand {
   std::int64_t utime = 0;
   std::string target;
   Kind command = Kind::RESET;
-  // RESET: restart from this pose (T_world_body) instead of the identity.
+  // RESET: restart from this pose (T_world_body); none: from the pose the node
+  // estimates now (its map dropped, the estimate does not jump).
   std::optional<Pose> initial_pose;
 };
 

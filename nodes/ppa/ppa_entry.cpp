@@ -41,6 +41,12 @@ class PpaLiveNode final : public Node {
       out << "; dropped " << node_.droppedImages()
           << " images, the first: " << node_.firstDropReason();
     }
+    const nodes::VoCommandListener& commands = node_.commands();
+    if (commands.resetsReceived() > 0) out << "; " << commands.resetsReceived() << " resets";
+    if (commands.droppedCommands() > 0) {
+      out << "; dropped " << commands.droppedCommands()
+          << " commands, the first: " << commands.firstDropReason();
+    }
     return out.str();
   }
 

@@ -33,6 +33,8 @@ void PpaNodeParams::visit(core::ParamVisitor& v) {
   v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
   v.field("odometry_channel", &odometry_channel, {.doc = "ppa_odometry_t out"});
   v.field("target_channel", &target_channel, {.doc = "target_detection_t out"});
+  v.field("command_channel", &command_channel,
+          {.doc = "vo_command_t in: resets for ppa or for every VO node"});
   v.field("target_extraction", &target_extraction,
           {.doc = "run target extraction after the odometry on every frame"});
   v.field("chip_instruction_rate_hz", &chip_instruction_rate_hz,
@@ -64,7 +66,10 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
             PpaCamera::fromFov(kWidth, kHeight, params.host.hfov_deg * std::numbers::pi / 180.0,
                                core::rotationBodyFromDownCamera()),
             std::move(targets_ne_m)),
-      inputs_(bus, params.range_channel, params.attitude_channel) {
+      inputs_(bus, params.range_channel, params.attitude_channel),
+      commands_(
+          bus, params.command_channel, kSourceName,
+          [this](const nodes::VoResetRequest& request) { pending_resets_.push_back(request); }) {
   subscriptions_.push_back(
       msg::subscribe<msg::Pose>(bus_, params_.truth_channel, [this](const msg::Pose& pose) {
         if (!first_truth_) first_truth_ = pose;
@@ -94,6 +99,23 @@ void PpaNode::drop(const std::string& reason) {
   if (dropped_images_++ == 0) first_drop_reason_ = reason;
 }
 
+void PpaNode::applyResets() {
+  for (const nodes::VoResetRequest& request : pending_resets_) {
+    ++resets_;
+    // The chip takes the next frame as its key-frame; the host anchors it at
+    // the position asked for, or at the last estimate. The attitude is the
+    // flight controller's either way.
+    vo_.reset();
+    if (request.T_world_body) {
+      host_.initialise(request.T_world_body->translation());
+      last_p_ned_m_ = request.T_world_body->translation();
+    } else if (last_p_ned_m_) {
+      host_.initialise(*last_p_ned_m_);
+    }
+  }
+  pending_resets_.clear();
+}
+
 void PpaNode::onImage(const msg::Image& image) {
   cv::Mat gray = image.pixels;
   if (gray.type() != CV_8UC1 || gray.cols != kWidth || gray.rows != kHeight) {
@@ -102,6 +124,7 @@ void PpaNode::onImage(const msg::Image& image) {
     return;
   }
   if (!gray.isContinuous()) gray = gray.clone();
+  applyResets();
   if (!host_.initialised() && first_truth_ && first_truth_->utime <= image.utime) {
     host_.initialise(first_truth_->p_ned_m);
   }
@@ -133,6 +156,7 @@ void PpaNode::onImage(const msg::Image& image) {
     input.target_center_px = Eigen::Vector2d(target->center_x_px, target->center_y_px);
   }
   const PpaHostOutput out = host_.update(input);
+  if (out.status != PpaStatus::kInitializing) last_p_ned_m_ = out.p_ned_m;
 
   msg::VoEstimate estimate;
   estimate.utime = image.utime;
@@ -143,7 +167,7 @@ void PpaNode::onImage(const msg::Image& image) {
   estimate.p_ned_m = out.p_ned_m;
   estimate.q_world_body = out.q_world_body;
   estimate.num_features = vo.keyframe_edge_count;
-  estimate.num_resets = 0;
+  estimate.num_resets = resets_;
   estimate.processing_time_s = static_cast<double>(instructions) / params_.chip_instruction_rate_hz;
   msg::publish(bus_, params_.pose_channel, estimate);
 

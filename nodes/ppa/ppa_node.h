@@ -3,8 +3,9 @@
 // PPA camera's frames go through the emulated chip (visual odometry, then
 // target extraction), the host turns the alignment into a position with the
 // rangefinder and the flight controller's attitude, and the node publishes
-// vo_estimate_t, ppa_odometry_t and target_detection_t. Bad messages are
-// dropped and counted.
+// vo_estimate_t, ppa_odometry_t and target_detection_t. A RESET on
+// VO_COMMAND drops the key-frame and restarts the position at the next frame.
+// Bad messages are dropped and counted.
 
 #include <cstdint>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "lcmtypes/image.h"
 #include "lcmtypes/messages.h"
 #include "nodes/common/flight_inputs.h"
+#include "nodes/common/vo_command.h"
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/ppa_host.h"
 #include "nodes/ppa/ppa_node_params.h"
@@ -39,9 +41,13 @@ class PpaNode {
   const std::string& firstDropReason() const { return first_drop_reason_; }
   // Mean emulated instructions per frame so far.
   double meanInstructionsPerFrame() const;
+  // Resets applied (vo_estimate_t's num_resets).
+  int resets() const { return resets_; }
+  const nodes::VoCommandListener& commands() const { return commands_; }
 
  private:
   void onImage(const msg::Image& image);
+  void applyResets();
   void drop(const std::string& reason);
 
   core::Bus& bus_;
@@ -52,6 +58,13 @@ class PpaNode {
   PpaHost host_;
   nodes::FlightInputs inputs_;
   std::optional<msg::Pose> first_truth_;
+  // The last position estimated (not before the host had a height).
+  std::optional<Eigen::Vector3d> last_p_ned_m_;
+  // Reset requests taken since the last frame, applied before the next one
+  // (handlers and frames both run on the bus's dispatch thread).
+  std::vector<nodes::VoResetRequest> pending_resets_;
+  nodes::VoCommandListener commands_;
+  int resets_ = 0;
   std::uint64_t frames_ = 0;
   std::uint64_t dropped_images_ = 0;
   std::uint64_t instructions_ = 0;

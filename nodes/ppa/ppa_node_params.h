@@ -24,6 +24,8 @@ struct PpaNodeParams {
   std::string pose_channel = "POSE_PPA";
   std::string odometry_channel = "PPA_ODOMETRY";
   std::string target_channel = "PPA_TARGET";
+  // vo_command_t in: resets addressed to ppa or to every VO node.
+  std::string command_channel = "VO_COMMAND";
   bool target_extraction = true;
   // The emulated chip's instruction rate, Hz: processing_time_s = instructions / rate.
   double chip_instruction_rate_hz = 10e6;

@@ -114,9 +114,16 @@ FeatureVo::FeatureVo(const FeatureVoParams& params) : params_(params) {
 
 void FeatureVo::setStartPose(const Eigen::Isometry3d& T_world_body) {
   T_world_body_start_ = T_world_body;
+  T_world_body_last_ = T_world_body;
   start_pending_ = true;
+  seeded_unconfirmed_ = false;
   resetMap();
   status_ = VoStatus::kInitializing;
+}
+
+void FeatureVo::restart(const std::optional<Eigen::Isometry3d>& T_world_body) {
+  setStartPose(T_world_body.value_or(T_world_body_last_));
+  ++resets_;
 }
 
 FeatureVo::~FeatureVo() { collectBackgroundBa(true); }
@@ -235,6 +242,12 @@ VoFrameOutput FeatureVo::output(VoStatus status, const Eigen::Isometry3d& T_worl
 }
 
 VoFrameOutput FeatureVo::process(const VoFrameInput& in) {
+  const VoFrameOutput out = processFrame(in);
+  T_world_body_last_ = out.T_world_body;
+  return out;
+}
+
+VoFrameOutput FeatureVo::processFrame(const VoFrameInput& in) {
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
   T_body_cam.linear() = in.R_body_cam;
   if (start_pending_) {

@@ -104,6 +104,10 @@ class FeatureVo {
   // The pose of the body when the VO starts: the world frame the estimates are
   // published in. Drops any map and starts initialising from the next frame.
   void setStartPose(const Eigen::Isometry3d& T_world_body);
+  // A restart asked for from outside (a reset command): drops the map as
+  // setStartPose does and counts in the resets; from T_world_body, or without
+  // one from the last estimate, so that the estimate does not jump.
+  void restart(const std::optional<Eigen::Isometry3d>& T_world_body);
 
   VoFrameOutput process(const VoFrameInput& frame);
 
@@ -133,6 +137,7 @@ class FeatureVo {
     std::optional<Eigen::Quaterniond> q_world_cam_prior;
   };
 
+  VoFrameOutput processFrame(const VoFrameInput& in);
   void resetMap();
   void markTracked(const Frame& frame);
   void compactMap();
@@ -162,6 +167,8 @@ class FeatureVo {
 
   FeatureVoParams params_;
   Eigen::Isometry3d T_world_body_start_ = Eigen::Isometry3d::Identity();
+  // The last estimate: the last frame's output, or the start pose before a frame.
+  Eigen::Isometry3d T_world_body_last_ = Eigen::Isometry3d::Identity();
   VoStatus status_ = VoStatus::kInitializing;
 
   // Initialisation: the reference frame and its anchored camera pose.

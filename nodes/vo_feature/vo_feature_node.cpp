@@ -21,6 +21,8 @@ void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
   v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
   v.field("debug_channel", &debug_channel,
           {.doc = "image_t out: the frame with the tracked features (thesis figure 21)"});
+  v.field("command_channel", &command_channel,
+          {.doc = "vo_command_t in: resets for vo_feature or for every VO node"});
   v.field("debug_every_frames", &debug_every_frames,
           {.doc = "a debug image every this many frames (0: none)", .min = 0, .max = 1000000});
   v.field("debug_jpeg_quality", &debug_jpeg_quality,
@@ -36,7 +38,10 @@ VoFeatureNode::VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params)
     : bus_(bus),
       params_(params),
       vo_(params.vo),
-      inputs_(bus, params.range_channel, params.attitude_channel) {
+      inputs_(bus, params.range_channel, params.attitude_channel),
+      commands_(
+          bus, params.command_channel, kFeatureSourceName,
+          [this](const nodes::VoResetRequest& request) { pending_resets_.push_back(request); }) {
   subscriptions_.push_back(
       msg::subscribe<msg::Pose>(bus_, params_.truth_channel, [this](const msg::Pose& pose) {
         if (started_) return;
@@ -63,7 +68,17 @@ void VoFeatureNode::drop(const std::string& reason) {
   if (dropped_images_++ == 0) first_drop_reason_ = reason;
 }
 
+void VoFeatureNode::applyResets() {
+  for (const nodes::VoResetRequest& request : pending_resets_) {
+    vo_.restart(request.T_world_body);
+    // A pose given stands for the start pose the truth would give.
+    if (request.T_world_body) started_ = true;
+  }
+  pending_resets_.clear();
+}
+
 void VoFeatureNode::onImage(const msg::Image& image) {
+  applyResets();
   if (!info_ || !started_) return;  // the lens and the start pose come first
   const cv::Mat& frame = image.pixels;
   if (frame.cols != info_->width || frame.rows != info_->height) {

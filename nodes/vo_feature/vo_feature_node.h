@@ -2,8 +2,9 @@
 // nadir-vo-feature's work on a bus, the same in the live node and in `nadir
 // run`: the downward camera's frames go through FeatureVo with the
 // rangefinder's range (and optionally the flight controller's attitude as a
-// prior), and vo_estimate_t goes out on POSE_VO_FEATURE. Bad messages are
-// dropped and counted.
+// prior), and vo_estimate_t goes out on POSE_VO_FEATURE. A RESET on
+// VO_COMMAND restarts the VO at the next frame. Bad messages are dropped and
+// counted.
 
 #include <chrono>
 #include <cstdint>
@@ -18,6 +19,7 @@
 #include "lcmtypes/image.h"
 #include "lcmtypes/messages.h"
 #include "nodes/common/flight_inputs.h"
+#include "nodes/common/vo_command.h"
 #include "nodes/vo_feature/feature_vo.h"
 
 namespace nadir::vo {
@@ -39,6 +41,8 @@ struct VoFeatureNodeParams {
   // The debug image (the thesis's figure 21): every this many frames (0: none),
   // as JPEG of this quality.
   std::string debug_channel = "VO_FEATURE_DEBUG";
+  // vo_command_t in: resets addressed to vo_feature or to every VO node.
+  std::string command_channel = "VO_COMMAND";
   int debug_every_frames = 10;
   int debug_jpeg_quality = 80;
   // Use the flight controller's attitude as a prior for each frame's rotation.
@@ -62,9 +66,11 @@ class VoFeatureNode {
   double processingSeconds() const { return processing_s_; }
   const FeatureVoTiming& timing() const { return vo_.timing(); }
   const FeatureVo& vo() const { return vo_; }
+  const nodes::VoCommandListener& commands() const { return commands_; }
 
  private:
   void onImage(const msg::Image& image);
+  void applyResets();
   void drop(const std::string& reason);
   void publishDebugImage(const cv::Mat& frame, std::int64_t utime, const VoFrameOutput& out);
 
@@ -73,6 +79,10 @@ class VoFeatureNode {
   FeatureVo vo_;
   std::optional<msg::CameraInfo> info_;
   nodes::FlightInputs inputs_;
+  // Reset requests taken since the last frame, applied before the next one
+  // (handlers and frames both run on the bus's dispatch thread).
+  std::vector<nodes::VoResetRequest> pending_resets_;
+  nodes::VoCommandListener commands_;
   bool started_ = false;
   std::uint64_t frames_ = 0;
   std::uint64_t dropped_images_ = 0;

@@ -5,11 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -137,6 +139,32 @@ TEST(GuiLiveFeed, CountsDamagedMessagesAndIgnoresOthers) {
   EXPECT_NE(run->damage.find("1 undecodable or invalid message on POSE_VO_DIRECT"),
             std::string::npos)
       << run->damage;
+}
+
+// The newest truth pose is the live truth while it is recent: an older one
+// coming late does not replace it, a damaged one is not taken, and once the
+// newest is older than the age asked for there is none.
+TEST(GuiLiveFeed, KeepsTheNewestTruthWhileItIsLive) {
+  const std::unique_ptr<core::Bus> bus = core::openBus("memq://");
+  LiveFeed feed(*bus);
+  const std::chrono::milliseconds long_age(60000);
+  EXPECT_FALSE(feed.liveTruth(long_age));
+  ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(100.0));
+  ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(100.5));
+  ::nadir::test::publish(*bus, "POSE_TRUTH", truthMessage(100.25));  // late
+  nadir::pose_t not_a_rotation = truthMessage(100.75);
+  for (double& w : not_a_rotation.orientation) w = 0.0;
+  ::nadir::test::publish(*bus, "POSE_TRUTH", not_a_rotation);
+  while (feed.poll() > 0) {
+  }
+  const std::optional<msg::Pose> truth = feed.liveTruth(long_age);
+  ASSERT_TRUE(truth);
+  EXPECT_EQ(truth->utime, utimeOf(100.5));
+  EXPECT_LT((truth->p_ned_m - test::truthPosition(100.5)).norm(), 1e-9);
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(feed.liveTruth(std::chrono::milliseconds(10)));
+  EXPECT_TRUE(feed.liveTruth(long_age));
 }
 
 // The live images are kept up to the budget, oldest dropped first; an image that

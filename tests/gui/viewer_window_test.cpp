@@ -1,7 +1,7 @@
 // nadir-viewer's window on a real run (made by `nadir run`, see CMakeLists.txt) on a
 // display with OpenGL 4.5 core: seeking, the time readout, the vehicle marker
 // against the truth, playback, a rendered frame whose red ribbon lies where the
-// projection of the truth says, and the terrain of any run.
+// projection of the truth says, the terrain of any run, and live mode's Reset VO.
 #include "gui/viewer_window.h"
 
 #include <QAction>
@@ -9,7 +9,9 @@
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QImage>
+#include <QMenu>
 #include <QMouseEvent>
+#include <QToolButton>
 #include <QWheelEvent>
 
 #include <gtest/gtest.h>
@@ -31,9 +33,12 @@
 #include "gui/live_feed.h"
 #include "gui/run_data.h"
 #include "gui/trajectory_view.h"
+#include "gui/vo_reset_sender.h"
 #include "gui_test_util.h"
+#include "lcmtypes/bus_io.h"
 #include "nadir/image_t.hpp"
 #include "nadir/pose_t.hpp"
+#include "nadir/vo_estimate_t.hpp"
 #include "tests/support/lcm_messages.h"
 
 namespace nadir::gui {
@@ -429,6 +434,65 @@ TEST_F(GuiViewerWindow, LiveModeFollowsTheBus) {
   ASSERT_EQ(window.runs().size(), 1u);
   EXPECT_EQ(window.runs().front().truth.size(), 11u);
   EXPECT_NEAR(window.duration(), 1.0, 1e-6);
+}
+
+// Live mode's Reset VO button: a RESET to every VO node at the newest truth
+// pose (the truth is live); its menu lists each source seen and resets one.
+TEST_F(GuiViewerWindow, LiveResetButtonSendsTheNewestTruth) {
+  const std::unique_ptr<core::Bus> bus = core::openBus("memq://");
+  LiveFeed feed(*bus);
+  VoResetSender sender(*bus, "VO_COMMAND");
+  ViewerWindow window({}, std::nullopt);
+  window.show();
+  window.attachLive(feed, QStringLiteral("live"), 0);
+  auto* reset = window.findChild<QToolButton*>(QStringLiteral("vo_reset"));
+  ASSERT_NE(reset, nullptr);
+  EXPECT_FALSE(reset->isVisibleTo(&window));
+  window.attachVoReset(sender);
+  EXPECT_TRUE(reset->isVisibleTo(&window));
+
+  std::vector<msg::VoCommand> sent;
+  const core::Subscription listen = msg::subscribe<msg::VoCommand>(
+      *bus, "VO_COMMAND", [&sent](const msg::VoCommand& command) { sent.push_back(command); });
+  for (int k = 0; k < 11; ++k) {
+    const double t = test::truthStamp(k);
+    ::nadir::test::publish(*bus, "POSE_TRUTH",
+                           test::poseMessage(t, test::truthPosition(t), test::attitude()));
+  }
+  nadir::vo_estimate_t estimate{};
+  estimate.utime = static_cast<std::int64_t>(std::llround(test::truthStamp(10) * 1e6));
+  estimate.source = "vo_feature";
+  estimate.status = nadir::vo_estimate_t::STATUS_TRACKING;
+  estimate.pose = test::poseMessage(test::truthStamp(10), test::truthPosition(test::truthStamp(10)),
+                                    test::attitude());
+  ::nadir::test::publish(*bus, "POSE_VO_FEATURE", estimate);
+  window.pollLive();
+
+  reset->click();
+  bus->handleAvailable();
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_TRUE(sent[0].target.empty());
+  ASSERT_TRUE(sent[0].initial_pose.has_value());
+  EXPECT_EQ(sent[0].utime, estimate.utime);
+  EXPECT_LT((sent[0].initial_pose->p_ned_m - test::truthPosition(test::truthStamp(10))).norm(),
+            1e-9);
+
+  // The menu: every node, then each source seen.
+  QStringList items;
+  QAction* one = nullptr;
+  for (QAction* action : reset->menu()->actions()) {
+    if (action->isSeparator()) continue;
+    items << action->text();
+    if (action->text() == QStringLiteral("Reset vo_feature")) one = action;
+  }
+  EXPECT_EQ(items, (QStringList{QStringLiteral("Reset every VO node"),
+                                QStringLiteral("Reset vo_feature")}));
+  ASSERT_NE(one, nullptr);
+  one->trigger();
+  bus->handleAvailable();
+  ASSERT_EQ(sent.size(), 2u);
+  EXPECT_EQ(sent[1].target, "vo_feature");
+  EXPECT_TRUE(sent[1].initial_pose.has_value());
 }
 
 // Runs opened from the window are added to the others; the first brings its

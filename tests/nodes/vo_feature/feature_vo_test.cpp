@@ -1,6 +1,7 @@
 // FeatureVo on synthetic flights: a random-texture ground plane 150 m below,
 // rendered into each 1280x960 frame with the exact homography of the camera
-// pose, along a known trajectory (straight and level, then a gentle banked turn).
+// pose (tests/support/textured_ground.h), along a known trajectory (straight
+// and level, then a gentle banked turn).
 
 #include "nodes/vo_feature/feature_vo.h"
 
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "core/frames.h"
+#include "tests/support/textured_ground.h"
 
 namespace nadir::vo {
 namespace {
@@ -23,64 +25,14 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr int kWidth = 1280;
 constexpr int kHeight = 960;
 constexpr double kAltitudeM = 150.0;  // ground at world z = 0, the camera at z = -150
-constexpr double kTextureResM = 0.2;  // ground metres per texture pixel
-constexpr int kTextureSize = 4000;    // covers +-400 m north and east
-constexpr double kTextureHalfM = 400.0;
 constexpr double kDtS = 0.1;
 constexpr double kSpeedMps = 20.0;
 const cv::Matx33d kK(800, 0, 640, 0, 800, 480, 0, 0, 1);
 
-// Multi-scale random texture: noise at four scales, fixed seed.
-const cv::Mat& groundTexture() {
-  static const cv::Mat texture = [] {
-    cv::RNG rng(12345);
-    cv::Mat sum = cv::Mat::zeros(kTextureSize, kTextureSize, CV_32F);
-    for (int k = 0; k < 4; ++k) {
-      const int size = kTextureSize >> k;
-      cv::Mat noise(size, size, CV_32F);
-      rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
-      cv::Mat up;
-      cv::resize(noise, up, sum.size(), 0, 0, cv::INTER_CUBIC);
-      sum += up;
-    }
-    cv::GaussianBlur(sum, sum, cv::Size(0, 0), 1.0);
-    cv::Mat out;
-    cv::normalize(sum, sum, 0, 255, cv::NORM_MINMAX);
-    sum.convertTo(out, CV_8U);
-    cv::equalizeHist(out, out);
-    return out;
-  }();
-  return texture;
-}
+using test::bodyPose;
 
-Eigen::Isometry3d bodyPose(const Eigen::Vector3d& p, double roll, double pitch, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                   .matrix();
-  T.translation() = p;
-  return T;
-}
-
-// The frame a camera at T_world_cam sees: texture pixel (u, v) is the ground
-// point north = 400 - 0.2 v, east = -400 + 0.2 u, down = 0.
 cv::Mat render(const Eigen::Isometry3d& T_world_cam) {
-  Eigen::Matrix3d A;
-  A << 0, -kTextureResM, kTextureHalfM, kTextureResM, 0, -kTextureHalfM, 0, 0, 0;
-  const Eigen::Matrix3d R_cw = T_world_cam.linear().transpose();
-  Eigen::Matrix3d M = A;
-  M.col(2) -= T_world_cam.translation();
-  Eigen::Matrix3d K;
-  K << kK(0, 0), 0, kK(0, 2), 0, kK(1, 1), kK(1, 2), 0, 0, 1;
-  const Eigen::Matrix3d H = K * R_cw * M;
-  cv::Matx33d H_cv;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) H_cv(r, c) = H(r, c);
-  cv::Mat frame;
-  cv::warpPerspective(groundTexture(), frame, H_cv, cv::Size(kWidth, kHeight), cv::INTER_LINEAR,
-                      cv::BORDER_CONSTANT, cv::Scalar(0));
-  return frame;
+  return test::renderGround(T_world_cam, kK, cv::Size(kWidth, kHeight));
 }
 
 // Straight and level north for 60 frames, then a right turn at 3 deg/s with
