@@ -15,35 +15,17 @@
 
 #include <CLI/CLI.hpp>
 
-#include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
-#include "core/bus.h"
-#include "core/lcm_log.h"
-#include "lcmtypes/bus_io.h"
+#include "bench/vo_replay.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/scenario.h"
 #include "nodes/vo_feature/vo_feature_node.h"
-
-namespace {
-
-namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-double msPerFrame(double seconds, std::int64_t frames) {
-  return frames > 0 ? 1e3 * seconds / static_cast<double>(frames) : 0.0;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"The feature VO over a recorded run's images: frames/s and accuracy"};
@@ -67,67 +49,19 @@ int main(int argc, char** argv) {
   cv::setNumThreads(threads);
 
   try {
-    const fs::path run(run_dir);
-    const fs::path log_path = run / "run.lcmlog";
-    const fs::path scenario_path = run / "scenario.yaml";
-    if (!fs::exists(log_path) || !fs::exists(scenario_path)) {
-      std::cerr << "nadir-bench-vo-feature: " << run_dir
-                << " is not a nadir run folder (run.lcmlog and scenario.yaml)\n";
-      return 2;
-    }
-    if (out_dir.empty()) out_dir = (run / "bench").string();
-    fs::create_directories(out_dir);
-
+    const nadir::bench::RunFolder folder = nadir::bench::openRunFolder(run_dir, out_dir);
     nadir::nodes::ScenarioParams scenario =
-        nadir::nodes::loadScenario(scenario_path.string(), overrides);
+        nadir::nodes::loadScenario(folder.scenario.string(), overrides);
     nadir::vo::VoFeatureNodeParams params =
         scenario.node<nadir::vo::VoFeatureNodeParams>(nadir::vo::kFeatureSourceName);
     params.wall_clock_timing = true;
-    nadir::core::BusParams bus_params;
-    bus_params.url = "memq://";
-    auto bus = nadir::core::openBus(bus_params);
-
-    const std::string out_log = (fs::path(out_dir) / "run.lcmlog").string();
-    nadir::core::LcmLogWriter writer(out_log);
-    nadir::core::Subscription recorder =
-        bus->subscribe(params.truth_channel + "|" + params.pose_channel,
-                       [&writer](const nadir::core::RawMessage& raw) {
-                         writer.write(nadir::core::peekUtime(raw).value_or(0),
-                                      std::string(raw.channel), raw.data, raw.size);
-                       });
-    nadir::vo::VoFeatureNode node(*bus, params);
-    std::optional<std::int64_t> first_image_utime;
-    bool debug_written = false;
-    nadir::core::Subscription debug_subscription = nadir::msg::subscribe<nadir::msg::Image>(
-        *bus, params.debug_channel, [&](const nadir::msg::Image& image) {
-          if (debug_png.empty() || debug_written || !first_image_utime) return;
-          if (image.utime < *first_image_utime + static_cast<std::int64_t>(debug_at_s * 1e6))
-            return;
-          cv::Mat bgr;
-          cv::cvtColor(image.pixels, bgr, cv::COLOR_RGB2BGR);
-          cv::imwrite(debug_png, bgr);
-          debug_written = true;
-        });
-
-    nadir::core::LcmLogReader reader(log_path.string());
-    bool saw_images = false;
-    const auto wall_start = Clock::now();
-    while (auto event = reader.next()) {
-      if (event->channel == params.image_channel) {
-        saw_images = true;
-        if (!first_image_utime) first_image_utime = event->timestamp_utime;
-      }
-      bus->publish(event->channel, event->data.data(), event->data.size(), event->timestamp_utime);
-      bus->handleAvailable();
-      if (max_frames > 0 && static_cast<std::int64_t>(node.frames()) >= max_frames) break;
-    }
-    const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
-    writer.flush();
-    if (!saw_images) {
-      std::cerr << "nadir-bench-vo-feature: " << log_path.string() << " holds no "
-                << params.image_channel << " images (recorded with --no-images?)\n";
-      return 2;
-    }
+    nadir::bench::VoReplay replay(folder, params.truth_channel, params.pose_channel,
+                                  params.image_channel, params.debug_channel, debug_png,
+                                  debug_at_s);
+    nadir::vo::VoFeatureNode node(replay.bus(), params);
+    const double wall_s = replay.replay(
+        [&] { return max_frames > 0 && static_cast<std::int64_t>(node.frames()) >= max_frames; });
+    using nadir::bench::msPerFrame;
 
     const nadir::vo::FeatureVoTiming& t = node.timing();
     std::printf("frames            %lld (%lld key-frames), %llu images dropped\n",
@@ -147,13 +81,14 @@ int main(int argc, char** argv) {
                 node.vo().numMapPoints(), node.vo().storedMapPoints(), node.vo().numKeyframes());
     std::printf("wall (with log)   %.1f s\n", wall_s);
     if (!debug_png.empty())
-      std::printf("debug image       %s\n", debug_written ? debug_png.c_str() : "none written");
+      std::printf("debug image       %s\n",
+                  replay.debugWritten() ? debug_png.c_str() : "none written");
     if (!node.firstDropReason().empty())
       std::printf("first drop        %s\n", node.firstDropReason().c_str());
 
     nadir::eval::EvalOptions options;
     const nadir::eval::RunEvaluation evaluation =
-        nadir::eval::evaluateRunLog(out_log, out_dir, options);
+        nadir::eval::evaluateRunLog(replay.estimatesLog(), folder.out.string(), options);
     std::cout << nadir::eval::formatResultsTable(evaluation.metrics);
     return 0;
   } catch (const std::exception& error) {

@@ -9,6 +9,7 @@ namespace nadir::nodes {
 std::unique_ptr<Entry> cameraEntry();
 std::unique_ptr<Entry> ppaEntry();
 std::unique_ptr<Entry> voFeatureEntry();
+std::unique_ptr<Entry> voDirectEntry();
 std::unique_ptr<Entry> simEntry();
 
 bool Node::turn(core::Bus& bus) {
@@ -22,6 +23,7 @@ const std::vector<std::unique_ptr<Entry>>& registry() {
     list.push_back(cameraEntry());
     list.push_back(ppaEntry());
     list.push_back(voFeatureEntry());
+    list.push_back(voDirectEntry());
     list.push_back(simEntry());
     return list;
   }();

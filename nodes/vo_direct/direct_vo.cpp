@@ -118,19 +118,16 @@ DirectVo::DirectVo(const DirectVoParams& params) : params_(params) {
 void DirectVo::setStartPose(const Eigen::Isometry3d& T_world_body) {
   dropMap();
   pending_start_ = T_world_body;
+  pending_in_place_ = false;
   pending_is_reset_ = false;
   started_ = false;
   delta_ = Eigen::Isometry3d::Identity();
 }
 
 void DirectVo::requestReset(const std::optional<Eigen::Isometry3d>& T_world_body) {
-  if (T_world_body) {
-    pending_start_ = *T_world_body;
-  } else if (started_) {
-    pending_start_ = predictCamWorld(frames_since_good_ - 1).inverse() * T_body_cam_.inverse();
-  } else {
-    return;  // nothing estimated yet: the start pose stands
-  }
+  if (!T_world_body && !started_) return;  // nothing estimated yet: the start pose stands
+  pending_start_ = T_world_body;
+  pending_in_place_ = !T_world_body;
   pending_is_reset_ = true;
 }
 
@@ -189,8 +186,12 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
       std::make_unique<ImagePyramid>(in.gray, params_.pyramid_levels, params_.tracker.finest_level);
   timing_.pyramid_s += secondsSince(t0);
 
-  if (pending_start_) {
-    const Eigen::Isometry3d T_cam_world = (*pending_start_ * T_body_cam_).inverse();
+  if (pending_start_ || pending_in_place_) {
+    // In place: where the motion model puts this frame, so the estimate does not jump.
+    const Eigen::Isometry3d T_cam_world = pending_in_place_
+                                              ? predictCamWorld(frames_since_good_)
+                                              : (*pending_start_ * T_body_cam_).inverse();
+    pending_in_place_ = false;
     dropMap();
     if (pending_is_reset_) ++resets_;
     pending_is_reset_ = false;

@@ -148,6 +148,7 @@ class DirectVo {
   // A start or reset pose waiting for the next frame (T_world_body), and
   // whether it counts as a reset.
   std::optional<Eigen::Isometry3d> pending_start_;
+  bool pending_in_place_ = false;  // a reset without a pose
   bool pending_is_reset_ = false;
   bool started_ = false;
 

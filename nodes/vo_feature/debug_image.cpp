@@ -2,6 +2,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nodes/common/status_line.h"
+
 #include <stdexcept>
 
 namespace nadir::vo {
@@ -30,14 +32,7 @@ cv::Mat drawDebugImage(const cv::Mat& frame, const std::vector<DebugFeature>& fe
       cv::circle(rgb, c, 1, blue, cv::FILLED);
     }
   }
-  const double font_scale = std::max(0.4, rgb.cols / 1600.0);
-  int baseline = 0;
-  const cv::Size text =
-      cv::getTextSize(status_text, cv::FONT_HERSHEY_SIMPLEX, font_scale, 1, &baseline);
-  cv::rectangle(rgb, cv::Point(0, 0), cv::Point(text.width + 12, text.height + baseline + 10),
-                cv::Scalar(0, 0, 0), cv::FILLED);
-  cv::putText(rgb, status_text, cv::Point(6, text.height + 5), cv::FONT_HERSHEY_SIMPLEX, font_scale,
-              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  nodes::drawStatusLine(rgb, status_text);
   return rgb;
 }
 

@@ -1,9 +1,7 @@
 #include "nodes/vo_feature/vo_feature_node.h"
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <sstream>
+#include <variant>
 
 #include "core/frames.h"
 #include "lcmtypes/bus_io.h"
@@ -38,27 +36,19 @@ VoFeatureNode::VoFeatureNode(core::Bus& bus, const VoFeatureNodeParams& params)
     : bus_(bus),
       params_(params),
       vo_(params.vo),
-      inputs_(bus, params.range_channel, params.attitude_channel),
+      source_(bus,
+              {.info_channel = params.info_channel,
+               .range_channel = params.range_channel,
+               .attitude_channel = params.attitude_channel,
+               .truth_channel = params.truth_channel},
+              [this](const Eigen::Isometry3d& T_world_body) {
+                if (started_) return;
+                vo_.setStartPose(T_world_body);
+                started_ = true;
+              }),
       commands_(
           bus, params.command_channel, kFeatureSourceName,
           [this](const nodes::VoResetRequest& request) { pending_resets_.push_back(request); }) {
-  subscriptions_.push_back(
-      msg::subscribe<msg::Pose>(bus_, params_.truth_channel, [this](const msg::Pose& pose) {
-        if (started_) return;
-        Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-        T_world_body.linear() = pose.q_world_body.toRotationMatrix();
-        T_world_body.translation() = pose.p_ned_m;
-        vo_.setStartPose(T_world_body);
-        started_ = true;
-      }));
-  subscriptions_.push_back(msg::subscribe<msg::CameraInfo>(
-      bus_, params_.info_channel, [this](const msg::CameraInfo& info) {
-        if (!info_ || info_->width != info.width || info_->height != info.height ||
-            info_->fx != info.fx || info_->distortion.size() != info.distortion.size()) {
-          undistort_map_x_.release();
-        }
-        info_ = info;
-      }));
   subscriptions_.push_back(msg::subscribe<msg::Image>(
       bus_, params_.image_channel, [this](const msg::Image& image) { onImage(image); },
       [this](const std::string& reason) { drop(reason); }));
@@ -79,42 +69,13 @@ void VoFeatureNode::applyResets() {
 
 void VoFeatureNode::onImage(const msg::Image& image) {
   applyResets();
-  if (!info_ || !started_) return;  // the lens and the start pose come first
-  const cv::Mat& frame = image.pixels;
-  if (frame.cols != info_->width || frame.rows != info_->height) {
-    drop("image " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
-         " does not match camera_info_t's " + std::to_string(info_->width) + "x" +
-         std::to_string(info_->height));
+  if (!source_.hasLens() || !started_) return;  // the lens and the start pose come first
+  auto made = source_.frame(image, params_.attitude_prior);
+  if (const std::string* reason = std::get_if<std::string>(&made)) {
+    drop(*reason);
     return;
   }
-  cv::Mat gray;
-  if (frame.channels() == 3) {
-    cv::cvtColor(frame, gray, cv::COLOR_RGB2GRAY);
-  } else {
-    gray = frame;
-  }
-  const cv::Matx33d K(info_->fx, 0, info_->cx, 0, info_->fy, info_->cy, 0, 0, 1);
-  if (info_->distorted()) {
-    if (undistort_map_x_.empty()) {
-      const std::vector<double> coefficients(info_->distortion.begin(), info_->distortion.end());
-      cv::initUndistortRectifyMap(K, coefficients, cv::noArray(), K, gray.size(), CV_32FC1,
-                                  undistort_map_x_, undistort_map_y_);
-    }
-    cv::Mat undistorted;
-    cv::remap(gray, undistorted, undistort_map_x_, undistort_map_y_, cv::INTER_LINEAR);
-    gray = undistorted;
-  }
-
-  const std::optional<Eigen::Quaterniond> attitude = inputs_.attitudeAt(image.utime);
-  VoFrameInput input;
-  input.utime = image.utime;
-  input.gray = gray;
-  input.K = K;
-  input.R_body_cam = info_->q_body_cam.toRotationMatrix();
-  // The rangefinder looks along the body's down axis.
-  input.range_m = inputs_.validRange_m();
-  input.range_ray_cam = input.R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
-  if (params_.attitude_prior) input.q_world_body_prior = attitude;
+  const VoFrameInput& input = std::get<VoFrameInput>(made);
 
   const auto started = std::chrono::steady_clock::now();
   const VoFrameOutput out = vo_.process(input);
@@ -126,9 +87,7 @@ void VoFeatureNode::onImage(const msg::Image& image) {
   msg::VoEstimate estimate;
   estimate.utime = image.utime;
   estimate.source = kFeatureSourceName;
-  estimate.status = out.status == VoStatus::kTracking ? msg::VoStatus::TRACKING
-                    : out.status == VoStatus::kLost   ? msg::VoStatus::LOST
-                                                      : msg::VoStatus::INITIALIZING;
+  estimate.status = nodes::wireStatus(out.status);
   estimate.p_ned_m = out.T_world_body.translation();
   estimate.q_world_body = Eigen::Quaterniond(out.T_world_body.rotation());
   estimate.num_features = out.tracked_points;
@@ -137,14 +96,12 @@ void VoFeatureNode::onImage(const msg::Image& image) {
   msg::publish(bus_, params_.pose_channel, estimate);
   if (params_.debug_every_frames > 0 &&
       (frames_ - 1) % static_cast<std::uint64_t>(params_.debug_every_frames) == 0)
-    publishDebugImage(gray, image.utime, out);
+    publishDebugImage(input.gray, image.utime, out);
 }
 
 void VoFeatureNode::publishDebugImage(const cv::Mat& frame, std::int64_t utime,
                                       const VoFrameOutput& out) {
-  const char* status = out.status == VoStatus::kTracking ? "TRACKING"
-                       : out.status == VoStatus::kLost   ? "LOST"
-                                                         : "INITIALIZING";
+  const char* status = nodes::statusName(out.status);
   const std::vector<DebugFeature>& features = vo_.lastFrameFeatures();
   std::ostringstream text;
   text << status << "  " << out.tracked_points << " matched of " << features.size()

@@ -18,8 +18,8 @@
 #include "core/params.h"
 #include "lcmtypes/image.h"
 #include "lcmtypes/messages.h"
-#include "nodes/common/flight_inputs.h"
 #include "nodes/common/vo_command.h"
+#include "nodes/common/vo_frame_source.h"
 #include "nodes/vo_feature/feature_vo.h"
 
 namespace nadir::vo {
@@ -77,8 +77,7 @@ class VoFeatureNode {
   core::Bus& bus_;
   VoFeatureNodeParams params_;
   FeatureVo vo_;
-  std::optional<msg::CameraInfo> info_;
-  nodes::FlightInputs inputs_;
+  nodes::VoFrameSource source_;
   // Reset requests taken since the last frame, applied before the next one
   // (handlers and frames both run on the bus's dispatch thread).
   std::vector<nodes::VoResetRequest> pending_resets_;
@@ -88,7 +87,6 @@ class VoFeatureNode {
   std::uint64_t dropped_images_ = 0;
   double processing_s_ = 0.0;
   std::string first_drop_reason_;
-  cv::Mat undistort_map_x_, undistort_map_y_;
   std::vector<core::Subscription> subscriptions_;
 };
 

@@ -189,7 +189,7 @@ TEST(Run, FeatureVoTracksTheDemoFlight) {
   RunOptions options;
   options.scenario = "default";
   options.out_dir = tempDir("vo_feature");
-  options.overrides = {"duration_s=30"};
+  options.overrides = {"duration_s=30", "vo_direct.enabled=false"};
   options.record_images = false;
   const RunResult result = runScenario(options);
   ASSERT_EQ(result.metrics.sources.count("vo_feature"), 1u);
@@ -199,6 +199,36 @@ TEST(Run, FeatureVoTracksTheDemoFlight) {
   EXPECT_LT(vo.position_rmse_m, 5.0);
   EXPECT_LT(vo.rotation_rmse_deg, 1.0);
   EXPECT_LT(std::abs(vo.track_length_diff_pct), 3.0);
+}
+
+// The direct VO on 20 s of the demo flight, twice: it tracks every
+// frame, stays metric from the rangefinder, and its estimates on
+// POSE_VO_DIRECT are byte-identical between the runs.
+TEST(Run, DirectVoTracksTheDemoFlightTheSameTwice) {
+  std::vector<std::string> poses[2];
+  for (int k = 0; k < 2; ++k) {
+    RunOptions options;
+    options.scenario = "default";
+    options.out_dir = tempDir("vo_direct_" + std::to_string(k));
+    options.overrides = {"duration_s=20", "vo_feature.enabled=false"};
+    options.record_images = false;
+    const RunResult result = runScenario(options);
+    ASSERT_EQ(result.metrics.sources.count("vo_direct"), 1u);
+    const eval::SourceMetrics& vo = result.metrics.sources.at("vo_direct");
+    if (k == 0) {
+      EXPECT_TRUE(vo.initialised);
+      EXPECT_GT(vo.tracked_pct, 99.0);
+      EXPECT_LT(vo.position_rmse_m, 2.0);
+      EXPECT_LT(vo.rotation_rmse_deg, 0.5);
+      EXPECT_LT(std::abs(vo.track_length_diff_pct), 2.0);
+    }
+    core::LcmLogReader reader(result.log_path);
+    while (auto event = reader.next())
+      if (event->channel == "POSE_VO_DIRECT")
+        poses[k].emplace_back(event->data.begin(), event->data.end());
+  }
+  EXPECT_GT(poses[0].size(), 350u);  // 20 frames/s for 20 s
+  EXPECT_TRUE(poses[0] == poses[1]) << "the estimates differ between the runs";
 }
 
 // A sweep file's grid: every combination, last axis fastest, named by its values.
@@ -344,7 +374,7 @@ TEST(Launch, ADeadNodeIsReported) {
   LaunchOptions options;
   options.scenario = "default";
   options.out_dir = (fs::path(dir) / "out").string();
-  options.overrides = {"duration_s=30", "vo_feature.enabled=false"};
+  options.overrides = {"duration_s=30", "vo_feature.enabled=false", "vo_direct.enabled=false"};
   options.bin_dir = bin.string();
   std::atomic<bool> stop{false};
   std::ostringstream out;

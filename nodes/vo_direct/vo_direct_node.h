@@ -1,0 +1,82 @@
+#pragma once
+// nadir-vo-direct's work on a bus, the same in the live node and in `nadir
+// run`: the downward camera's frames go through DirectVo with the
+// rangefinder's range, vo_estimate_t goes out on POSE_VO_DIRECT and every N
+// frames the debug image on VO_DIRECT_DEBUG. A RESET on VO_COMMAND restarts
+// the VO at the next frame. Bad messages are dropped and counted.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/bus.h"
+#include "core/params.h"
+#include "lcmtypes/image.h"
+#include "nodes/common/vo_command.h"
+#include "nodes/common/vo_frame_source.h"
+#include "nodes/vo_direct/direct_vo.h"
+
+namespace nadir::vo {
+
+// The node's name: its scenario group, its source name in vo_estimate_t and the metrics.
+inline constexpr char kDirectSourceName[] = "vo_direct";
+
+struct VoDirectNodeParams {
+  // In a scenario: run the direct VO (nadir run composes it, nadir launch
+  // starts nadir-vo-direct).
+  bool enabled = false;
+  std::string image_channel = "CAMERA_DOWN";
+  std::string info_channel = "CAMERA_DOWN_INFO";
+  std::string range_channel = "RANGE";
+  std::string attitude_channel = "NAV_ATTITUDE";
+  // Read once: the start pose the estimate is anchored to.
+  std::string truth_channel = "POSE_TRUTH";
+  std::string pose_channel = "POSE_VO_DIRECT";
+  std::string debug_channel = "VO_DIRECT_DEBUG";
+  std::string command_channel = "VO_COMMAND";
+  // The debug image (the thesis's figure 20): every this many frames (0:
+  // none), as JPEG of this quality.
+  int debug_every_frames = 10;
+  int debug_jpeg_quality = 80;
+  // Publish the wall-clock processing time in vo_estimate_t (live); off, it is
+  // 0 so that runs are byte-identical (nadir run turns it off).
+  bool wall_clock_timing = true;
+  DirectVoParams vo;
+
+  void visit(core::ParamVisitor& v);
+};
+
+class VoDirectNode {
+ public:
+  VoDirectNode(core::Bus& bus, const VoDirectNodeParams& params);
+
+  std::uint64_t frames() const { return frames_; }
+  std::uint64_t droppedImages() const { return dropped_images_; }
+  const std::string& firstDropReason() const { return first_drop_reason_; }
+  // Wall-clock seconds spent in DirectVo::process, over all frames.
+  double processingSeconds() const { return processing_s_; }
+  const DirectVo& vo() const { return vo_; }
+  const nodes::VoCommandListener& commands() const { return commands_; }
+
+ private:
+  void onImage(const msg::Image& image);
+  void drop(const std::string& reason);
+  void publishDebugImage(std::int64_t utime, const DirectVoOutput& out);
+
+  core::Bus& bus_;
+  VoDirectNodeParams params_;
+  DirectVo vo_;
+  nodes::VoFrameSource source_;
+  // Reset requests taken since the last frame, applied before the next one
+  // (handlers and frames both run on the bus's dispatch thread).
+  std::vector<nodes::VoResetRequest> pending_resets_;
+  nodes::VoCommandListener commands_;
+  bool started_ = false;
+  std::uint64_t frames_ = 0;
+  std::uint64_t dropped_images_ = 0;
+  double processing_s_ = 0.0;
+  std::string first_drop_reason_;
+  std::vector<core::Subscription> subscriptions_;
+};
+
+}  // namespace nadir::vo
