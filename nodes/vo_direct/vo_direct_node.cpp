@@ -68,12 +68,12 @@ void VoDirectNode::onImage(const msg::Image& image) {
     vo_.requestReset(request.T_world_body);
   }
   pending_resets_.clear();
-  if (!source_.hasLens() || !started_) return;  // the lens and the start pose come first
   auto made = source_.frame(image, false);
   if (const std::string* reason = std::get_if<std::string>(&made)) {
-    drop(*reason);
+    if (!reason->empty()) drop(*reason);  // empty: the lens or the start pose has not come yet
     return;
   }
+  if (!started_) return;
   const VoFrameInput& input = std::get<VoFrameInput>(made);
 
   const auto started = std::chrono::steady_clock::now();
@@ -102,7 +102,7 @@ void VoDirectNode::publishDebugImage(std::int64_t utime, const DirectVoOutput& o
   if (vo_.keyframeImage().empty()) return;
   char text[160];
   std::snprintf(text, sizeof text,
-                "%s  %d points aligned  window %d key-frames %d points  resets %d  gain %+.3f",
+                "%s  %d points aligned  window %d key-frames %d points  resets %d  log gain %+.3f",
                 nodes::statusName(out.status), out.points, vo_.numKeyframes(), vo_.numPoints(),
                 out.resets, out.affine.a);
   msg::publish(bus_, params_.debug_channel,

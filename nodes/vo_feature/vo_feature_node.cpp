@@ -69,12 +69,12 @@ void VoFeatureNode::applyResets() {
 
 void VoFeatureNode::onImage(const msg::Image& image) {
   applyResets();
-  if (!source_.hasLens() || !started_) return;  // the lens and the start pose come first
   auto made = source_.frame(image, params_.attitude_prior);
   if (const std::string* reason = std::get_if<std::string>(&made)) {
-    drop(*reason);
+    if (!reason->empty()) drop(*reason);  // empty: the lens or the start pose has not come yet
     return;
   }
+  if (!started_) return;
   const VoFrameInput& input = std::get<VoFrameInput>(made);
 
   const auto started = std::chrono::steady_clock::now();
