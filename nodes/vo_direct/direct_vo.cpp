@@ -30,6 +30,10 @@ void DirectVoParams::visit(core::ParamVisitor& v) {
           {.doc = "key-frame when the flow from rotation and translation reaches this share of w+h",
            .min = 1e-4,
            .max = 10});
+  v.field("keyframe_scale_change", &keyframe_scale_change,
+          {.doc = "key-frame when the ground's distance changes by this share (climb, descent)",
+           .min = 1e-4,
+           .max = 10});
   v.field("keyframe_brightness", &keyframe_brightness,
           {.doc = "key-frame when the log gain changes by this", .min = 1e-3, .max = 100});
   v.field("keyframe_min_in_image", &keyframe_min_in_image,
@@ -306,7 +310,7 @@ bool DirectVo::needKeyframe(const TrackResult& r) const {
   const PinholeLevel& cam = reference_.cameras[level];
   const Eigen::Matrix3f R = r.T_frame_ref.linear().cast<float>();
   const Eigen::Vector3f t = r.T_frame_ref.translation().cast<float>();
-  double sum_t = 0, sum_rt = 0;
+  double sum_t = 0, sum_rt = 0, sum_scale = 0;
   int n = 0;
   const std::size_t stride = std::max<std::size_t>(1, points.size() / 500);
   for (std::size_t i = 0; i < points.size(); i += stride) {
@@ -321,6 +325,7 @@ bool DirectVo::needKeyframe(const TrackResult& r) const {
     const float vrt = cam.fy * q_rt.y() / q_rt.z() + cam.cy - p.y;
     sum_t += ut * ut + vt * vt;
     sum_rt += urt * urt + vrt * vrt;
+    sum_scale += q_rt.z();  // the point's depth in the frame over its depth in the key-frame
     ++n;
   }
   if (n == 0) return true;
@@ -329,8 +334,10 @@ bool DirectVo::needKeyframe(const TrackResult& r) const {
   const double flow_rt = scale * std::sqrt(sum_rt / n);
   const Keyframe& kf = keyframes_.back();
   const double wh = keyframes_.back().pyramid->width(0) + kf.pyramid->height(0);
+  const double scale_change = std::fabs(sum_scale / n - 1.0);
   const double score = flow_t / (params_.keyframe_flow_translation * wh) +
                        flow_rt / (params_.keyframe_flow_rotation_translation * wh) +
+                       scale_change / params_.keyframe_scale_change +
                        std::fabs(r.affine.a - kf.affine.a) / params_.keyframe_brightness;
   return score > 1.0;
 }

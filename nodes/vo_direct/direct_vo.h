@@ -39,11 +39,15 @@ struct DirectVoParams {
   // view has none, up to this).
   int max_points = 2000;
   // A new key-frame when, since the newest one, flow_t / (flow_translation *
-  // (w + h)) + flow_rt / (flow_rotation_translation * (w + h)) + |log gain
-  // change| / brightness exceeds 1: flow_t is the RMS optical flow of the
-  // points from the translation alone, flow_rt with the rotation.
-  double keyframe_flow_translation = 0.022;
+  // (w + h)) + flow_rt / (flow_rotation_translation * (w + h)) + |scale
+  // change| / scale_change + |log gain change| / brightness exceeds 1:
+  // flow_t is the RMS optical flow of the points from the translation alone,
+  // flow_rt with the rotation, the scale change the mean ratio of the points'
+  // depths in the frame and the key-frame, less one (climbs and descents,
+  // which the flow hardly shows at the image's centre).
+  double keyframe_flow_translation = 0.01;
   double keyframe_flow_rotation_translation = 0.045;
+  double keyframe_scale_change = 0.02;
   double keyframe_brightness = 0.5;
   // ... or when fewer than this share of its points stay in the image.
   double keyframe_min_in_image = 0.6;
