@@ -352,6 +352,14 @@ bool DirectVo::startMap(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInpu
   timing_.keyframe_s += secondsSince(t0);
   if (static_cast<int>(candidates.size()) < params_.min_start_points) return false;
   dropMap();
+  pushKeyframe(std::move(pyramid), T_cam_world, affine);
+  addPoints(0, candidates, {}, in);
+  makeTrackingReference();
+  return !points_.empty();
+}
+
+void DirectVo::pushKeyframe(std::unique_ptr<ImagePyramid> pyramid,
+                            const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine) {
   Keyframe kf;
   kf.pyramid = std::move(pyramid);
   kf.T_cam_world = T_cam_world;
@@ -359,22 +367,13 @@ bool DirectVo::startMap(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInpu
   kf.affine_prior = affine;
   keyframes_.push_back(std::move(kf));
   ++timing_.keyframes;
-  addPoints(0, candidates, {}, in);
-  makeTrackingReference();
-  return !points_.empty();
 }
 
 void DirectVo::addKeyframe(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                            const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine) {
   auto t0 = Clock::now();
   for (int l = 0; l < 3; ++l) pyramid->computeGradients(l);
-  Keyframe kf;
-  kf.pyramid = std::move(pyramid);
-  kf.T_cam_world = T_cam_world;
-  kf.affine = affine;
-  kf.affine_prior = affine;
-  keyframes_.push_back(std::move(kf));
-  ++timing_.keyframes;
+  pushKeyframe(std::move(pyramid), T_cam_world, affine);
   // The oldest key-frame and the points it hosts leave the window.
   while (static_cast<int>(keyframes_.size()) > params_.window_keyframes) {
     keyframes_.pop_front();

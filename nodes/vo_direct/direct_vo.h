@@ -136,6 +136,9 @@ class DirectVo {
   DirectVoOutput lostFrame(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                            int points);
   bool needKeyframe(const TrackResult& result) const;
+  // Appends a key-frame (its pyramid with gradients at levels 0-2) to the window.
+  void pushKeyframe(std::unique_ptr<ImagePyramid> pyramid, const Eigen::Isometry3d& T_cam_world,
+                    const AffineBrightness& affine);
   void addKeyframe(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                    const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine);
   void addPoints(int host, const std::vector<SelectedPixel>& candidates,

@@ -1,7 +1,6 @@
 // The direct VO's registry entry: its scenario group is its params.
 
-#include <sstream>
-
+#include "nodes/common/vo_node_summary.h"
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
 #include "nodes/vo_direct/vo_direct_node.h"
@@ -13,23 +12,7 @@ class VoDirectLiveNode final : public Node {
  public:
   VoDirectLiveNode(core::Bus& bus, const vo::VoDirectNodeParams& params) : node_(bus, params) {}
 
-  std::string summary() const override {
-    std::ostringstream out;
-    out << node_.frames() << " frames, "
-        << (node_.frames() ? 1000.0 * node_.processingSeconds() / node_.frames() : 0.0)
-        << " ms per frame";
-    if (node_.droppedImages() > 0) {
-      out << "; dropped " << node_.droppedImages()
-          << " images, the first: " << node_.firstDropReason();
-    }
-    const nodes::VoCommandListener& commands = node_.commands();
-    if (commands.resetsReceived() > 0) out << "; " << commands.resetsReceived() << " resets";
-    if (commands.droppedCommands() > 0) {
-      out << "; dropped " << commands.droppedCommands()
-          << " commands, the first: " << commands.firstDropReason();
-    }
-    return out.str();
-  }
+  std::string summary() const override { return voNodeSummary(node_); }
 
  private:
   vo::VoDirectNode node_;
