@@ -80,9 +80,10 @@ int main(int argc, char** argv) {
                 t.frames / std::max(node.processingSeconds(), 1e-9), threads,
                 threads == 1 ? "" : "s");
     std::printf("  pyramid         %.2f ms/frame\n", msPerFrame(t.pyramid_s, t.frames));
-    std::printf("  track           %.2f ms/frame (pyramid levels %d to %d)\n",
+    std::printf("  track           %.2f ms/frame (pyramid levels %d to %d, %.1f steps a frame)\n",
                 msPerFrame(t.track_s, t.frames), params.vo.pyramid_levels - 1,
-                params.vo.tracker.finest_level);
+                params.vo.tracker.finest_level,
+                t.frames ? static_cast<double>(t.track_iterations) / t.frames : 0.0);
     std::printf("  key-frames      %.2f ms/frame (selection, new points, reference)\n",
                 msPerFrame(t.keyframe_s, t.frames));
     std::printf("  window          %.2f ms/frame (%.1f ms per key-frame)\n",

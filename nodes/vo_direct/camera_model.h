@@ -31,6 +31,19 @@ inline constexpr std::array<std::array<int, 2>, kPatternSize> kPattern = {
     {{0, -2}, {-1, -1}, {1, -1}, {-2, 0}, {0, 0}, {2, 0}, {-1, 1}, {0, 2}}};
 inline constexpr int kPatternRadius = 2;
 
+// The pattern's rays less the centre's (z = 0), turned by R: a pattern pixel of
+// a point whose centre ray is c lies on the ray c + offset, so that a point at
+// inverse depth rho maps to R c + rho t + (R offset), one rotation per pattern
+// pixel for all points instead of one per point.
+using PatternOffsets = std::array<Eigen::Vector3f, kPatternSize>;
+inline PatternOffsets rotatedPatternOffsets(const PinholeLevel& camera, const Eigen::Matrix3f& R) {
+  PatternOffsets out;
+  for (int k = 0; k < kPatternSize; ++k)
+    out[k] = R * Eigen::Vector3f(static_cast<float>(kPattern[k][0]) / camera.fx,
+                                 static_cast<float>(kPattern[k][1]) / camera.fy, 0.f);
+  return out;
+}
+
 // The weight of a pixel by the reference's gradient there, c^2 / (c^2 +
 // |grad|^2): on strong edges a small misalignment or blur makes large
 // residuals. Taken from the reference (key-frame, host), not from the image

@@ -275,7 +275,7 @@ DirectVoOutput DirectVo::lostFrame(std::unique_ptr<ImagePyramid> pyramid, const 
   return output(VoStatus::kLost, T_pred, points, false);
 }
 
-TrackResult DirectVo::track(const ImagePyramid& pyramid) const {
+TrackResult DirectVo::track(const ImagePyramid& pyramid) {
   const Keyframe& kf = keyframes_.back();
   const Eigen::Isometry3d T_kf_inv = kf.T_cam_world.inverse();
   // The constant-velocity guess first; if it fails, no motion and twice the motion.
@@ -287,6 +287,7 @@ TrackResult DirectVo::track(const ImagePyramid& pyramid) const {
   for (const Eigen::Isometry3d& guess : guesses) {
     TrackResult r =
         trackFrame(reference_, pyramid, guess * T_kf_inv, affine_last_, params_.tracker);
+    timing_.track_iterations += r.iterations;
     if (!isLost(r)) return r;
     if (!have || r.rms < best.rms) {
       best = r;
@@ -315,7 +316,7 @@ bool DirectVo::needKeyframe(const TrackResult& r) const {
   const std::size_t stride = std::max<std::size_t>(1, points.size() / 500);
   for (std::size_t i = 0; i < points.size(); i += stride) {
     const TrackingPoint& p = points[i];
-    const Eigen::Vector3f& ray = p.rays[4];
+    const Eigen::Vector3f& ray = p.ray;
     const Eigen::Vector3f q_t = ray + p.idepth * t;
     const Eigen::Vector3f q_rt = R * ray + p.idepth * t;
     if (q_t.z() <= 1e-6f || q_rt.z() <= 1e-6f) continue;
@@ -348,7 +349,8 @@ bool DirectVo::startMap(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInpu
   if (!plane) return false;
   const auto t0 = Clock::now();
   for (int l = 0; l < 3; ++l) pyramid->computeGradients(l);
-  const std::vector<SelectedPixel> candidates = selectPixels(*pyramid, params_.selection);
+  const std::vector<SelectedPixel> candidates =
+      selectPixels(*pyramid, params_.selection, &selection_cell_px_);
   timing_.keyframe_s += secondsSince(t0);
   if (static_cast<int>(candidates.size()) < params_.min_start_points) return false;
   dropMap();
@@ -393,7 +395,7 @@ void DirectVo::addKeyframe(std::unique_ptr<ImagePyramid> pyramid, const VoFrameI
     const Eigen::Isometry3d T =
         keyframes_[host].T_cam_world * keyframes_[p.host].T_cam_world.inverse();
     const Eigen::Vector3f q =
-        T.linear().cast<float>() * p.rays[4] + p.idepth * T.translation().cast<float>();
+        T.linear().cast<float>() * p.ray + p.idepth * T.translation().cast<float>();
     if (q.z() <= 1e-6f) return true;
     const float x = cam.fx * q.x() / q.z() + cam.cx;
     const float y = cam.fy * q.y() / q.z() + cam.cy;
@@ -402,7 +404,7 @@ void DirectVo::addKeyframe(std::unique_ptr<ImagePyramid> pyramid, const VoFrameI
     return false;
   });
   const std::vector<SelectedPixel> candidates =
-      selectPixels(*keyframes_.back().pyramid, params_.selection);
+      selectPixels(*keyframes_.back().pyramid, params_.selection, &selection_cell_px_);
   addPoints(host, candidates, projected, in);
   timing_.keyframe_s += secondsSince(t0);
 
@@ -487,7 +489,7 @@ void DirectVo::addPoints(int host, const std::vector<SelectedPixel>& candidates,
       const float ground_idepth = ground->idepth(ray);
       if (ground_idepth > 0.f) p.idepth_range = ground_idepth;
     }
-    preparePoint(p, *kf.pyramid, cam, params_.window.gradient_weight_c);
+    preparePoint(p, *kf.pyramid, K_, params_.window);
     return p;
   };
   // Every key-frame with a range hosts points around the rangefinder ray's
@@ -556,7 +558,7 @@ void DirectVo::makeTrackingReference() {
     }
     const Eigen::Isometry3d T = kf.T_cam_world * keyframes_[p.host].T_cam_world.inverse();
     const Eigen::Vector3f q =
-        T.linear().cast<float>() * p.rays[4] + p.idepth * T.translation().cast<float>();
+        T.linear().cast<float>() * p.ray + p.idepth * T.translation().cast<float>();
     if (q.z() <= 1e-6f) continue;
     const float x = cam.fx * q.x() / q.z() + cam.cx;
     const float y = cam.fy * q.y() / q.z() + cam.cy;

@@ -37,7 +37,7 @@ struct DirectVoParams {
   int window_keyframes = 7;
   // Points the window holds at most (a new key-frame adds points where the
   // view has none, up to this).
-  int max_points = 2000;
+  int max_points = 1000;
   // A new key-frame when, since the newest one, flow_t / (flow_translation *
   // (w + h)) + flow_rt / (flow_rotation_translation * (w + h)) + |scale
   // change| / scale_change + |log gain change| / brightness exceeds 1:
@@ -81,6 +81,7 @@ struct DirectVoTiming {
   double window_s = 0;    // the windowed optimisation
   std::int64_t frames = 0;
   std::int64_t keyframes = 0;
+  std::int64_t track_iterations = 0;  // Levenberg-Marquardt steps tried, all levels and guesses
 };
 
 struct DirectVoOutput {
@@ -130,7 +131,7 @@ class DirectVo {
   Eigen::Isometry3d predictCamWorld(int steps) const;
   bool startMap(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                 const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine);
-  TrackResult track(const ImagePyramid& pyramid) const;
+  TrackResult track(const ImagePyramid& pyramid);
   bool isLost(const TrackResult& result) const;
   // The frame's pose when it is lost: the motion model's.
   DirectVoOutput lostFrame(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
@@ -175,6 +176,8 @@ class DirectVo {
   // next frame cannot, it is made again there (the same loss, no new reset).
   bool unconfirmed_ = false;
   double typical_rms_ = 0.0;  // 0: none yet for this map
+  double selection_cell_px_ =
+      0.0;  // the last key-frame's selection cell: the next one starts there
   int resets_ = 0;
 
   DirectVoTiming timing_;

@@ -27,8 +27,10 @@ void TrackerParams::visit(core::ParamVisitor& v) {
           {.doc = "photometric noise the priors are weighed against, intensity",
            .min = 0.01,
            .max = 255});
-  v.field("convergence_step", &convergence_step,
-          {.doc = "a level stops when its step is below this (rad, relative)", .min = 0, .max = 1});
+  v.field("convergence_px", &convergence_px,
+          {.doc = "a level stops when a step moves the image by less than this, level px",
+           .min = 0,
+           .max = 10});
 }
 
 TrackingReference makeTrackingReference(const ImagePyramid& keyframe, const cv::Matx33d& K,
@@ -76,9 +78,9 @@ TrackingReference makeTrackingReference(const ImagePyramid& keyframe, const cv::
         tp.idepth = sum.at<float>(y, x) / c[x];
         tp.x = static_cast<float>(x);
         tp.y = static_cast<float>(y);
+        tp.ray = cam.ray(tp.x, tp.y);
         for (int k = 0; k < kPatternSize; ++k) {
           const int px = x + kPattern[k][0], py = y + kPattern[k][1];
-          tp.rays[k] = cam.ray(static_cast<float>(px), static_cast<float>(py));
           const float* sample = samples.ptr<float>(py) + 3 * px;
           tp.intensities[k] = sample[0];
           tp.weights[k] = gradientWeight(sample[1], sample[2], c2);
@@ -106,6 +108,33 @@ struct LevelSystem {
   int points_total = 0;
 };
 
+// Sums over a point's pattern of w z z^T and w r z for z = (gx, gy, d/da, d/db),
+// the upper triangle of the symmetric 4x4 kept as ten scalars.
+struct PatternSums {
+  float gg00 = 0, gg01 = 0, gg11 = 0;            // gradient x gradient
+  float ga00 = 0, ga01 = 0, ga10 = 0, ga11 = 0;  // gradient x brightness
+  float aa00 = 0, aa01 = 0, aa11 = 0;            // brightness x brightness
+  float rg0 = 0, rg1 = 0, ra0 = 0, ra1 = 0;
+
+  void add(float w, float gx, float gy, float za, float zb, float r) {
+    const float wgx = w * gx, wgy = w * gy, wza = w * za, wzb = w * zb;
+    gg00 += wgx * gx;
+    gg01 += wgx * gy;
+    gg11 += wgy * gy;
+    ga00 += wgx * za;
+    ga01 += wgx * zb;
+    ga10 += wgy * za;
+    ga11 += wgy * zb;
+    aa00 += wza * za;
+    aa01 += wza * zb;
+    aa11 += wzb * zb;
+    rg0 += wgx * r;
+    rg1 += wgy * r;
+    ra0 += wza * r;
+    ra1 += wzb * r;
+  }
+};
+
 // The photometric system at one level for the frame's pose T (frame <- ref)
 // and brightness; linearize = false computes the energy only.
 // The points a level works with are chosen at its first evaluation (select):
@@ -122,6 +151,7 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
   LevelSystem sys;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
+  const PatternOffsets offsets = rotatedPatternOffsets(cam, R);
   // Residuals symmetric in the two frames' brightness (see frame_tracker.h).
   const float half_gain = static_cast<float>(std::exp(0.5 * (frame.a - ref.a)));
   const float inv_half_gain = 1.f / half_gain;
@@ -132,21 +162,29 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
   const float x_max = static_cast<float>(samples.cols - 1) - margin;
   const float y_max = static_cast<float>(samples.rows - 1) - margin;
   const float oob_penalty = kPatternSize * k * k;
+  // The pose block in float, summed into double every point: J^T Zgg J,
+  // J^T Zga, J^T zr; the brightness block does not depend on the point.
+  Eigen::Matrix<double, 6, 6> H_pose = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 2> H_pose_affine = Eigen::Matrix<double, 6, 2>::Zero();
+  Eigen::Matrix<double, 6, 1> g_pose = Eigen::Matrix<double, 6, 1>::Zero();
+  double aa00 = 0, aa01 = 0, aa11 = 0, ra0 = 0, ra1 = 0;
   if (select) active.assign(points.size(), 0);
   for (std::size_t pi = 0; pi < points.size(); ++pi) {
     const TrackingPoint& p = points[pi];
     ++sys.points_total;
     if (!select && !active[pi]) continue;
+    const Eigen::Vector3f qc = R * p.ray + p.idepth * t;
     std::array<float, kPatternSize> u, v;
-    bool inside = true;
+    bool inside = qc.z() > 1e-6f;
     for (int i = 0; i < kPatternSize && inside; ++i) {
-      const Eigen::Vector3f q = R * p.rays[i] + p.idepth * t;
+      const Eigen::Vector3f q = qc + offsets[i];
       if (q.z() <= 1e-6f) {
         inside = false;
         break;
       }
-      u[i] = cam.fx * q.x() / q.z() + cam.cx;
-      v[i] = cam.fy * q.y() / q.z() + cam.cy;
+      const float iz = 1.f / q.z();
+      u[i] = cam.fx * q.x() * iz + cam.cx;
+      v[i] = cam.fy * q.y() * iz + cam.cy;
       inside = u[i] >= margin && v[i] >= margin && u[i] < x_max && v[i] < y_max;
     }
     if (!inside) {
@@ -155,9 +193,7 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
     }
     if (select) active[pi] = 1;
     ++sys.points_in;
-    // z = (gx, gy, d/da, d/db); Z = sum w z z^T, zr = sum w z r.
-    Eigen::Matrix4f Z = Eigen::Matrix4f::Zero();
-    Eigen::Vector4f zr = Eigen::Vector4f::Zero();
+    PatternSums z;
     for (int i = 0; i < kPatternSize; ++i) {
       const IntensitySample s = ImagePyramid::sample(samples, u[i], v[i]);
       const float seen = inv_half_gain * (s.intensity - frame_b);
@@ -168,24 +204,38 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
       sys.data_cost += wg * cost;
       sys.match_cost += cost;
       if (!linearize) continue;
-      const float w = wg * huberWeight(r, k);
-      const Eigen::Vector4f z(inv_half_gain * s.dx, inv_half_gain * s.dy, -0.5f * (seen + expected),
-                              -inv_half_gain);
-      Z.noalias() += w * z * z.transpose();
-      zr.noalias() += w * r * z;
+      z.add(wg * huberWeight(r, k), inv_half_gain * s.dx, inv_half_gain * s.dy,
+            -0.5f * (seen + expected), -inv_half_gain, r);
     }
     sys.residuals += kPatternSize;
     if (!linearize) continue;
-    const Eigen::Vector3f qc = R * p.rays[4] + p.idepth * t;  // the pattern's centre
     const ProjectionJacobian J = projectionJacobian(qc, p.idepth, t, cam.fx, cam.fy);
-    Eigen::Matrix<float, 4, 8> S = Eigen::Matrix<float, 4, 8>::Zero();
-    S.topLeftCorner<2, 6>() = J.d_xi;
-    S(2, 6) = 1.f;
-    S(3, 7) = 1.f;
-    sys.H.noalias() += (S.transpose() * Z * S).cast<double>();
-    sys.g.noalias() += (S.transpose() * zr).cast<double>();
+    Eigen::Matrix2f Zgg;
+    Zgg << z.gg00, z.gg01, z.gg01, z.gg11;
+    Eigen::Matrix2f Zga;
+    Zga << z.ga00, z.ga01, z.ga10, z.ga11;
+    const Eigen::Matrix<float, 2, 6> ZJ = Zgg * J.d_xi;
+    H_pose.noalias() += J.d_xi.transpose().lazyProduct(ZJ).cast<double>();
+    H_pose_affine.noalias() += J.d_xi.transpose().lazyProduct(Zga).cast<double>();
+    g_pose.noalias() += (J.d_xi.transpose() * Eigen::Vector2f(z.rg0, z.rg1)).cast<double>();
+    aa00 += z.aa00;
+    aa01 += z.aa01;
+    aa11 += z.aa11;
+    ra0 += z.ra0;
+    ra1 += z.ra1;
   }
   sys.energy += sys.data_cost;
+  if (linearize) {
+    sys.H.topLeftCorner<6, 6>() = H_pose;
+    sys.H.topRightCorner<6, 2>() = H_pose_affine;
+    sys.H.bottomLeftCorner<2, 6>() = H_pose_affine.transpose();
+    sys.H(6, 6) = aa00;
+    sys.H(6, 7) = sys.H(7, 6) = aa01;
+    sys.H(7, 7) = aa11;
+    sys.g.head<6>() = g_pose;
+    sys.g(6) = ra0;
+    sys.g(7) = ra1;
+  }
   // Priors on the brightness change from the key-frame.
   const double sigma2 = params.photometric_sigma * params.photometric_sigma;
   const double wa = sigma2 / (params.affine_prior_sigma_a * params.affine_prior_sigma_a);
@@ -235,7 +285,11 @@ TrackResult trackFrame(const TrackingReference& reference, const ImagePyramid& f
       for (int i = 0; i < 8; ++i) H(i, i) *= 1.0 + lambda;
       const Vector8d step = -H.ldlt().solve(sys.g);
       if (!step.allFinite()) break;
-      Vector6d xi = step.head<6>();
+      const Vector6d xi = step.head<6>();
+      const double focal = reference.cameras[l].fx;
+      const double moved_px = focal * (xi.tail<3>().norm() + xi.head<3>().norm() / depth_scale);
+      const double gain = std::fabs(step(6)) + std::fabs(step(7)) / 255.0;
+      const bool small = moved_px < params.convergence_px && gain < 0.01 * params.convergence_px;
       const Eigen::Isometry3d T_new = orthonormalized(se3Exp(xi) * T);
       const AffineBrightness affine_new{affine.a + step(6), affine.b + step(7)};
       LevelSystem trial = evaluate(points, active, false, samples, reference.cameras[l], T_new,
@@ -245,17 +299,14 @@ TrackResult trackFrame(const TrackingReference& reference, const ImagePyramid& f
         affine = affine_new;
         sys = trial;
         lambda = std::max(lambda * 0.25, 1e-6);
+        if (small) break;
       } else {
+        // A small step that does not descend: the level is at its minimum
+        // (more damping would only shrink the step further).
+        if (small) break;
         lambda *= 10.0;
         if (lambda > 1e6) break;
-        continue;
       }
-      const double rot = xi.tail<3>().norm();
-      const double trans = xi.head<3>().norm() / depth_scale;
-      const double gain = std::fabs(step(6)) + std::fabs(step(7)) / 255.0;
-      if (rot < params.convergence_step && trans < params.convergence_step &&
-          gain < params.convergence_step)
-        break;
     }
     const double rms = sys.residuals > 0 ? std::sqrt(sys.match_cost / sys.residuals) : 1e9;
     if (l == coarsest) result.coarse_rms = rms;

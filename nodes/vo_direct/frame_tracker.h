@@ -43,17 +43,18 @@ struct TrackerParams {
   double affine_prior_sigma_a = 0.2;
   double affine_prior_sigma_b = 20.0;
   double photometric_sigma = 4.0;
-  // Stop a level when the step's rotation and translation (relative to the
-  // points' mean depth) fall below this.
-  double convergence_step = 1e-5;
+  // Stop a level when a step moves the image by less than this, in the level's
+  // pixels (rotation and translation at the points' mean depth), and changes
+  // the gain by less than this over 100.
+  double convergence_px = 0.05;
 
   void visit(core::ParamVisitor& v);
 };
 
-// One reference pixel at one level: the rays through its pattern pixels, the
-// key-frame's intensities there, its inverse depth in the key-frame.
+// One reference pixel at one level: the ray through it (z = 1), the
+// key-frame's intensities at its pattern pixels, its inverse depth in the key-frame.
 struct TrackingPoint {
-  std::array<Eigen::Vector3f, kPatternSize> rays;
+  Eigen::Vector3f ray;
   std::array<float, kPatternSize> intensities;
   std::array<float, kPatternSize> weights;  // gradientWeight at the key-frame's pixels
   float idepth = 0;

@@ -46,11 +46,18 @@ void ImagePyramid::computeGradients(int level) {
     const float* down = I.ptr<float>(std::min(y + 1, I.rows - 1));
     const float dy_scale = (y == 0 || y == I.rows - 1) ? 1.f : 0.5f;
     float* o = out.ptr<float>(y);
-    for (int x = 0; x < I.cols; ++x) {
-      const int xl = std::max(x - 1, 0);
-      const int xr = std::min(x + 1, I.cols - 1);
+    // The borders take one-sided differences; the interior runs without branches.
+    const int last = I.cols - 1;
+    for (int x = 1; x < last; ++x) {
       o[3 * x] = row[x];
-      o[3 * x + 1] = (row[xr] - row[xl]) * ((x == 0 || x == I.cols - 1) ? 1.f : 0.5f);
+      o[3 * x + 1] = 0.5f * (row[x + 1] - row[x - 1]);
+      o[3 * x + 2] = (down[x] - up[x]) * dy_scale;
+    }
+    for (const int x : {0, last}) {
+      const int xl = std::max(x - 1, 0);
+      const int xr = std::min(x + 1, last);
+      o[3 * x] = row[x];
+      o[3 * x + 1] = row[xr] - row[xl];
       o[3 * x + 2] = (down[x] - up[x]) * dy_scale;
     }
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 namespace nadir::vo {
@@ -25,11 +26,20 @@ namespace {
 
 constexpr int kScales = 3;
 constexpr int kHistogramBins = 64;
+constexpr int kLastBinSquared = (kHistogramBins - 1) * (kHistogramBins - 1);
 
 // Median gradient magnitude per block plus the margin, smoothed 3x3 over blocks.
 cv::Mat blockThresholds(const cv::Mat& samples, int block, double margin) {
   const int bw = (samples.cols + block - 1) / block;
   const int bh = (samples.rows + block - 1) / block;
+  // floor(sqrt(g2)) == floor(sqrt(floor(g2))): the bin of a squared magnitude
+  // from a table, without a square root per pixel.
+  static const std::array<std::uint8_t, kLastBinSquared> bin_of_squared = [] {
+    std::array<std::uint8_t, kLastBinSquared> table{};
+    for (int i = 0; i < kLastBinSquared; ++i)
+      table[i] = static_cast<std::uint8_t>(std::sqrt(static_cast<double>(i)));
+    return table;
+  }();
   cv::Mat raw(bh, bw, CV_32F);
   std::array<int, kHistogramBins> histogram{};
   for (int by = 0; by < bh; ++by) {
@@ -39,9 +49,9 @@ cv::Mat blockThresholds(const cv::Mat& samples, int block, double margin) {
       for (int y = by * block; y < std::min((by + 1) * block, samples.rows); ++y) {
         const float* row = samples.ptr<float>(y);
         for (int x = bx * block; x < std::min((bx + 1) * block, samples.cols); ++x) {
-          const float g =
-              std::sqrt(row[3 * x + 1] * row[3 * x + 1] + row[3 * x + 2] * row[3 * x + 2]);
-          ++histogram[std::min(static_cast<int>(g), kHistogramBins - 1)];
+          const float g2 = row[3 * x + 1] * row[3 * x + 1] + row[3 * x + 2] * row[3 * x + 2];
+          ++histogram[g2 < kLastBinSquared ? bin_of_squared[static_cast<int>(g2)]
+                                           : kHistogramBins - 1];
           ++count;
         }
       }
@@ -156,7 +166,7 @@ std::vector<SelectedPixel> selectWithCell(const ImagePyramid& pyramid, const cv:
 }  // namespace
 
 std::vector<SelectedPixel> selectPixels(const ImagePyramid& pyramid,
-                                        const PixelSelectionParams& params) {
+                                        const PixelSelectionParams& params, double* cell_px) {
   if (pyramid.levels() < kScales)
     throw std::invalid_argument("selectPixels: the pyramid needs at least 3 levels");
   for (int l = 0; l < kScales; ++l)
@@ -168,7 +178,8 @@ std::vector<SelectedPixel> selectPixels(const ImagePyramid& pyramid,
   // A cell of c x c pixels gives at most one pixel: start where a full grid
   // would hit the target, then correct by the share found (textureless
   // regions give none), at most twice.
-  double cell = std::sqrt(area / params.target_points);
+  double cell =
+      cell_px != nullptr && *cell_px >= 1.0 ? *cell_px : std::sqrt(area / params.target_points);
   std::vector<SelectedPixel> best;
   for (int attempt = 0; attempt < 3; ++attempt) {
     const int c = std::max(1, static_cast<int>(std::lround(cell)));
@@ -176,8 +187,10 @@ std::vector<SelectedPixel> selectPixels(const ImagePyramid& pyramid,
     const double ratio = static_cast<double>(pixels.size()) / params.target_points;
     if (best.empty() || std::fabs(std::log(std::max(ratio, 1e-3))) <
                             std::fabs(std::log(std::max(
-                                static_cast<double>(best.size()) / params.target_points, 1e-3))))
+                                static_cast<double>(best.size()) / params.target_points, 1e-3)))) {
       best = std::move(pixels);
+      if (cell_px != nullptr) *cell_px = c;
+    }
     if (ratio > 0.8 && ratio < 1.25) break;
     if (ratio <= 0.0 || c == 1) break;
     cell = std::max(1.0, c * std::sqrt(ratio));

@@ -34,8 +34,12 @@ struct SelectedPixel {
   float gradient = 0;  // gradient magnitude at that scale
 };
 
-// The pyramid needs gradients at levels 0-2.
+// The pyramid needs gradients at levels 0-2. The cell size (level-0 px) that
+// hits the target is found by trial; cell_px, when given, holds where to start
+// (0: from the image's area) and receives the size used, so that a sequence of
+// similar images mostly needs one trial.
 std::vector<SelectedPixel> selectPixels(const ImagePyramid& pyramid,
-                                        const PixelSelectionParams& params);
+                                        const PixelSelectionParams& params,
+                                        double* cell_px = nullptr);
 
 }  // namespace nadir::vo

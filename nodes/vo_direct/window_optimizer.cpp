@@ -1,7 +1,9 @@
 #include "nodes/vo_direct/window_optimizer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "nodes/vo_direct/lie.h"
 
@@ -38,15 +40,15 @@ void WindowOptimizerParams::visit(core::ParamVisitor& v) {
            .max = 100});
 }
 
-void preparePoint(WindowPoint& point, const ImagePyramid& host, const PinholeLevel& camera,
-                  double gradient_weight_c) {
+void preparePoint(WindowPoint& point, const ImagePyramid& host, const cv::Matx33d& K,
+                  const WindowOptimizerParams& params) {
   if (!host.hasGradients(0))
     throw std::invalid_argument("preparePoint: the host has no level-0 gradients");
-  const float c2 = static_cast<float>(gradient_weight_c * gradient_weight_c);
+  const float c2 = static_cast<float>(params.gradient_weight_c * params.gradient_weight_c);
+  point.ray = PinholeLevel::at(K, 0).ray(point.x, point.y);
   for (int k = 0; k < kPatternSize; ++k) {
     const float x = point.x + static_cast<float>(kPattern[k][0]);
     const float y = point.y + static_cast<float>(kPattern[k][1]);
-    point.rays[k] = camera.ray(x, y);
     const IntensitySample s = ImagePyramid::sample(host.samples(0), x, y);
     point.intensities[k] = s.intensity;
     point.weights[k] = gradientWeight(s.dx, s.dy, c2);
@@ -58,16 +60,25 @@ namespace {
 constexpr int kMaxFrames = 32;
 constexpr int kJoinMarginPx = 8;
 using Vector8d = Eigen::Matrix<double, 8, 1>;
-using Matrix16f = Eigen::Matrix<float, 16, 16>;
-using Vector16f = Eigen::Matrix<float, 16, 1>;
 using Matrix6f = Eigen::Matrix<float, 6, 6>;
 using Vector6f = Eigen::Matrix<float, 6, 1>;
+
+using Matrix10d = Eigen::Matrix<double, 10, 10>;
+using Vector10d = Eigen::Matrix<double, 10, 1>;
 
 struct PointSystem {
   double Hpp = 0.0;
   double bp = 0.0;
-  std::uint32_t frames = 0;  // bit f: Hfp[f] holds something
-  std::array<Vector8d, kMaxFrames> Hfp;
+  std::uint32_t frames = 0;  // bit f: the point's block with frame f holds something
+};
+
+// The blocks of one (host, target) pair, in the pair's relative coordinates:
+// the relative pose (6), the target's (a, b), the host's (a, b). Summed over
+// the pair's points, then mapped to the two key-frames' own coordinates once.
+struct PairSystem {
+  Matrix10d H = Matrix10d::Zero();
+  Vector10d g = Vector10d::Zero();
+  bool used = false;
 };
 
 struct System {
@@ -78,6 +89,16 @@ struct System {
   Eigen::MatrixXd H;  // frames x frames, before eliminating the points
   Eigen::VectorXd g;
   std::vector<PointSystem> points;
+  // Point p's coupling with frame f: hfp[(p * frames + f) * 8 ...], 8 values.
+  std::vector<double> hfp;
+  int frames = 0;
+
+  Eigen::Map<Vector8d> Hfp(std::size_t p, int f) {
+    return Eigen::Map<Vector8d>(hfp.data() + (p * frames + f) * 8);
+  }
+  Eigen::Map<const Vector8d> Hfp(std::size_t p, int f) const {
+    return Eigen::Map<const Vector8d>(hfp.data() + (p * frames + f) * 8);
+  }
 };
 
 struct State {
@@ -176,32 +197,41 @@ class Optimizer {
     sys.H = Eigen::MatrixXd::Zero(8 * free_frames_, 8 * free_frames_);
     sys.g = Eigen::VectorXd::Zero(8 * free_frames_);
     sys.points.resize(points_.size());
-    // Relative poses and their adjoints, target <- host.
+    sys.frames = n;
+    sys.hfp.assign(points_.size() * n * 8, 0.0);
+    // Relative poses, their adjoints and the turned pattern, target <- host.
     std::vector<Eigen::Matrix3f> R(n * n);
     std::vector<Eigen::Vector3f> t(n * n);
-    std::vector<Eigen::Matrix<float, 6, 6>> Ad(n * n);
+    std::vector<Matrix6d> Ad(n * n);
+    std::vector<Matrix6f> minus_Ad_T(n * n);
+    std::vector<PatternOffsets> offsets(n * n);
+    std::vector<PairSystem> pairs(n * n);
     for (int h = 0; h < n; ++h)
       for (int g = 0; g < n; ++g) {
         if (h == g) continue;
         const Eigen::Isometry3d T = s.T_cam_world[g] * s.T_cam_world[h].inverse();
         R[h * n + g] = T.linear().cast<float>();
         t[h * n + g] = T.translation().cast<float>();
-        Ad[h * n + g] = adjoint(T).cast<float>();
+        Ad[h * n + g] = adjoint(T);
+        minus_Ad_T[h * n + g] = -Ad[h * n + g].transpose().cast<float>();
+        offsets[h * n + g] = rotatedPatternOffsets(camera_, R[h * n + g]);
       }
     const float k = static_cast<float>(params_.huber_threshold);
     const float outlier2 = static_cast<float>(params_.outlier_rms * params_.outlier_rms);
     const float oob_penalty = kPatternSize * k * k;
-    for (std::size_t pi = 0; pi < points_.size(); ++pi) {
-      const WindowPoint& p = points_[pi];
-      PointSystem& ps = sys.points[pi];
-      const float rho = s.idepth[pi];
-      const int h = p.host;
-      for (int g = 0; g < n; ++g) {
+    // Target by target: the lookups stay in one image at a time.
+    for (int g = 0; g < n; ++g) {
+      for (std::size_t pi = 0; pi < points_.size(); ++pi) {
+        const WindowPoint& p = points_[pi];
+        PointSystem& ps = sys.points[pi];
+        const float rho = s.idepth[pi];
+        const int h = p.host;
         if (g == h) continue;
         const std::uint32_t bit = 1u << g;
         if (!first && !(active_[pi] & bit)) continue;
-        const Eigen::Matrix3f& Rth = R[h * n + g];
-        const Eigen::Vector3f& tth = t[h * n + g];
+        const int pair = h * n + g;
+        const Eigen::Matrix3f& Rth = R[pair];
+        const Eigen::Vector3f& tth = t[pair];
         const cv::Mat& samples = frames_[g].pyramid->samples(0);
         // A block joins only well inside the image, so that the small moves of
         // the optimisation rarely take it out (it then costs the Huber cost
@@ -209,16 +239,18 @@ class Optimizer {
         const float margin = first ? static_cast<float>(kJoinMarginPx) : 1.f;
         const float x_max = static_cast<float>(samples.cols - 1) - margin;
         const float y_max = static_cast<float>(samples.rows - 1) - margin;
+        const Eigen::Vector3f qc = Rth * p.ray + rho * tth;
         std::array<float, kPatternSize> u, v;
-        bool inside = rho > 0.f;
+        bool inside = rho > 0.f && qc.z() > 1e-6f;
         for (int i = 0; i < kPatternSize && inside; ++i) {
-          const Eigen::Vector3f q = Rth * p.rays[i] + rho * tth;
+          const Eigen::Vector3f q = qc + offsets[pair][i];
           if (q.z() <= 1e-6f) {
             inside = false;
             break;
           }
-          u[i] = camera_.fx * q.x() / q.z() + camera_.cx;
-          v[i] = camera_.fy * q.y() / q.z() + camera_.cy;
+          const float iz = 1.f / q.z();
+          u[i] = camera_.fx * q.x() * iz + camera_.cx;
+          v[i] = camera_.fy * q.y() * iz + camera_.cy;
           inside = u[i] >= margin && v[i] >= margin && u[i] < x_max && v[i] < y_max;
         }
         if (!inside) {
@@ -249,53 +281,82 @@ class Optimizer {
           active_[pi] |= bit;
         }
         ++sys.blocks;
-        // z = (gx, gy, d/da_t, d/db_t, d/da_h, d/db_h).
-        Matrix6f Z = Matrix6f::Zero();
-        Vector6f zr = Vector6f::Zero();
+        // z = (gx, gy, d/da_t, d/db_t, d/da_h, d/db_h) = (gx, gy, -m, -1/g, m, g) with
+        // m the pixel's mean brightness and g the half gain: Z = sum w z z^T and
+        // zr = sum w r z follow from fourteen sums.
+        float sw = 0, swm = 0, swmm = 0, sgx = 0, sgy = 0, sgxm = 0, sgym = 0;
+        float sgxx = 0, sgxy = 0, sgyy = 0, srgx = 0, srgy = 0, srm = 0, sr = 0;
         for (int i = 0; i < kPatternSize; ++i) {
           const float wg = p.weights[i];
           const float cost = wg * huberCost(r[i], k);
           sys.photometric_cost += cost;
           sys.energy += cost;
           const float w = wg * huberWeight(r[i], k);
-          Vector6f z;
-          z << inv_half_gain * smp[i].dx, inv_half_gain * smp[i].dy, -mean[i], -inv_half_gain,
-              mean[i], half_gain;
-          Z.noalias() += w * z * z.transpose();
-          zr.noalias() += w * r[i] * z;
+          const float gx = inv_half_gain * smp[i].dx, gy = inv_half_gain * smp[i].dy;
+          const float wgx = w * gx, wgy = w * gy, wm = w * mean[i], wr = w * r[i];
+          sw += w;
+          swm += wm;
+          swmm += wm * mean[i];
+          sgx += wgx;
+          sgy += wgy;
+          sgxm += wgx * mean[i];
+          sgym += wgy * mean[i];
+          sgxx += wgx * gx;
+          sgxy += wgx * gy;
+          sgyy += wgy * gy;
+          srgx += wr * gx;
+          srgy += wr * gy;
+          srm += wr * mean[i];
+          sr += wr;
         }
+        const float ct = inv_half_gain, ch = half_gain;
+        Matrix6f Z;
+        Z << sgxx, sgxy, -sgxm, -ct * sgx, sgxm, ch * sgx,                           //
+            sgxy, sgyy, -sgym, -ct * sgy, sgym, ch * sgy,                            //
+            -sgxm, -sgym, swmm, ct * swm, -swmm, -ch * swm,                          //
+            -ct * sgx, -ct * sgy, ct * swm, ct * ct * sw, -ct * swm, -ct * ch * sw,  //
+            sgxm, sgym, -swmm, -ct * swm, swmm, ch * swm,                            //
+            ch * sgx, ch * sgy, -ch * swm, -ct * ch * sw, ch * swm, ch * ch * sw;
+        Vector6f zr;
+        zr << srgx, srgy, -srm, -ct * sr, srm, ch * sr;
         sys.residuals += kPatternSize;
-        const Eigen::Vector3f qc = Rth * p.rays[4] + rho * tth;
+        // The pair's system in relative coordinates: d(residual)/d(relative
+        // pose) = grad * J, brightness directly.
         const ProjectionJacobian J = projectionJacobian(qc, rho, tth, camera_.fx, camera_.fy);
-        Eigen::Matrix<float, 6, 16> S = Eigen::Matrix<float, 6, 16>::Zero();
-        S.block<2, 6>(0, 0) = J.d_xi;                   // target pose
-        S.block<2, 6>(0, 8) = -J.d_xi * Ad[h * n + g];  // host pose
-        S(2, 6) = 1.f;                                  // target a
-        S(3, 7) = 1.f;                                  // target b
-        S(4, 14) = 1.f;                                 // host a
-        S(5, 15) = 1.f;                                 // host b
-        Vector6f s_rho = Vector6f::Zero();
-        s_rho.head<2>() = J.d_rho;
-        const Eigen::Matrix<float, 16, 6> SZ = S.transpose() * Z;
-        const Matrix16f Hb = SZ * S;
-        const Vector16f gb = S.transpose() * zr;
-        const Vector16f hp = SZ * s_rho;
-        ps.Hpp += s_rho.dot(Z * s_rho);
-        ps.bp += s_rho.dot(zr);
-        const int fi[2] = {g, h};
-        for (int a = 0; a < 2; ++a) {
-          const int ba = block_of_[fi[a]];
-          if (ba < 0) continue;
-          sys.g.segment<8>(ba) += gb.segment<8>(8 * a).cast<double>();
-          ps.Hfp[fi[a]] += hp.segment<8>(8 * a).cast<double>();
-          ps.frames |= 1u << fi[a];
-          for (int b = 0; b < 2; ++b) {
-            const int bb = block_of_[fi[b]];
-            if (bb < 0) continue;
-            sys.H.block<8, 8>(ba, bb) += Hb.block<8, 8>(8 * a, 8 * b).cast<double>();
-          }
+        PairSystem& ph = pairs[pair];
+        ph.used = true;
+        const Eigen::Matrix<float, 2, 6> ZJ = Z.topLeftCorner<2, 2>() * J.d_xi;
+        ph.H.topLeftCorner<6, 6>().noalias() += J.d_xi.transpose().lazyProduct(ZJ).cast<double>();
+        ph.H.topRightCorner<6, 4>().noalias() +=
+            J.d_xi.transpose().lazyProduct(Z.topRightCorner<2, 4>()).cast<double>();
+        ph.H.bottomRightCorner<4, 4>() += Z.bottomRightCorner<4, 4>().cast<double>();
+        ph.g.head<6>().noalias() += (J.d_xi.transpose() * zr.head<2>()).cast<double>();
+        ph.g.tail<4>() += zr.tail<4>().cast<double>();
+        // The point's coupling: Z s_rho with s_rho = (d_rho, 0, 0, 0, 0).
+        const Vector6f z_rho = Z.leftCols<2>() * J.d_rho;
+        ps.Hpp += J.d_rho.dot(z_rho.head<2>());
+        ps.bp += J.d_rho.dot(zr.head<2>());
+        const Vector6f pose_rho = J.d_xi.transpose() * z_rho.head<2>();
+        if (block_of_[g] >= 0) {
+          auto Hfp = sys.Hfp(pi, g);
+          Hfp.head<6>() += pose_rho.cast<double>();
+          Hfp(6) += z_rho(2);
+          Hfp(7) += z_rho(3);
+          ps.frames |= 1u << g;
+        }
+        if (block_of_[h] >= 0) {
+          auto Hfp = sys.Hfp(pi, h);
+          Hfp.head<6>() += (minus_Ad_T[pair] * pose_rho).cast<double>();
+          Hfp(6) += z_rho(4);
+          Hfp(7) += z_rho(5);
+          ps.frames |= 1u << h;
         }
       }
+    }
+    for (std::size_t pi = 0; pi < points_.size(); ++pi) {
+      const WindowPoint& p = points_[pi];
+      PointSystem& ps = sys.points[pi];
+      const float rho = s.idepth[pi];
       // Priors on the inverse depth: weak around where it was made, and the
       // rangefinder's near its ray.
       const double prior0 = std::max(static_cast<double>(p.idepth_prior), 1e-9);
@@ -312,6 +373,35 @@ class Optimizer {
         ps.bp += wr * dr / rho;
       }
     }
+    // Each pair's relative system into the key-frames' coordinates:
+    // relative pose = xi_target - Ad(T_target_host) xi_host.
+    for (int h = 0; h < n; ++h)
+      for (int g = 0; g < n; ++g) {
+        const int pair = h * n + g;
+        if (h == g || !pairs[pair].used) continue;
+        Matrix10d H_rel = pairs[pair].H;
+        H_rel.bottomLeftCorner<4, 6>() = H_rel.topRightCorner<6, 4>().transpose();
+        Eigen::Matrix<double, 10, 16> S = Eigen::Matrix<double, 10, 16>::Zero();
+        S.block<6, 6>(0, 0).setIdentity();
+        S.block<6, 6>(0, 8) = -Ad[pair];
+        S(6, 6) = 1.0;
+        S(7, 7) = 1.0;
+        S(8, 14) = 1.0;
+        S(9, 15) = 1.0;
+        const Eigen::Matrix<double, 16, 16> Hb = S.transpose() * H_rel * S;
+        const Eigen::Matrix<double, 16, 1> gb = S.transpose() * pairs[pair].g;
+        const int fi[2] = {g, h};
+        for (int a = 0; a < 2; ++a) {
+          const int ba = block_of_[fi[a]];
+          if (ba < 0) continue;
+          sys.g.segment<8>(ba) += gb.segment<8>(8 * a);
+          for (int b = 0; b < 2; ++b) {
+            const int bb = block_of_[fi[b]];
+            if (bb < 0) continue;
+            sys.H.block<8, 8>(ba, bb) += Hb.block<8, 8>(8 * a, 8 * b);
+          }
+        }
+      }
     // Each key-frame's brightness near its tracking estimate.
     const double wa = sigma2_ / std::pow(params_.affine_prior_sigma_a, 2);
     const double wb = sigma2_ / std::pow(params_.affine_prior_sigma_b, 2);
@@ -336,16 +426,18 @@ class Optimizer {
     Eigen::MatrixXd H = sys.H;
     Eigen::VectorXd g = sys.g;
     for (int i = 0; i < H.rows(); ++i) H(i, i) *= 1.0 + lambda;
-    for (const PointSystem& ps : sys.points) {
+    for (std::size_t pi = 0; pi < sys.points.size(); ++pi) {
+      const PointSystem& ps = sys.points[pi];
       if (ps.frames == 0 || ps.Hpp <= 0.0) continue;
       const double inv = 1.0 / (ps.Hpp * (1.0 + lambda));
       for (int a = 0; a < n; ++a) {
         if (!(ps.frames & (1u << a))) continue;
         const int ba = block_of_[a];
-        g.segment<8>(ba) -= ps.Hfp[a] * (ps.bp * inv);
+        g.segment<8>(ba) -= sys.Hfp(pi, a) * (ps.bp * inv);
         for (int b = 0; b < n; ++b) {
           if (!(ps.frames & (1u << b))) continue;
-          H.block<8, 8>(ba, block_of_[b]) -= ps.Hfp[a] * ps.Hfp[b].transpose() * inv;
+          H.block<8, 8>(ba, block_of_[b]).noalias() -=
+              sys.Hfp(pi, a) * sys.Hfp(pi, b).transpose() * inv;
         }
       }
     }
@@ -365,7 +457,7 @@ class Optimizer {
       if (ps.Hpp <= 0.0) continue;
       double rhs = ps.bp;
       for (int f = 0; f < n; ++f)
-        if (ps.frames & (1u << f)) rhs += ps.Hfp[f].dot(dx.segment<8>(block_of_[f]));
+        if (ps.frames & (1u << f)) rhs += sys.Hfp(pi, f).dot(dx.segment<8>(block_of_[f]));
       const double d = -rhs / (ps.Hpp * (1.0 + lambda));
       const float old = s.idepth[pi];
       float next = old + static_cast<float>(d);

@@ -58,9 +58,9 @@ struct WindowPoint {
   float idepth_prior = 0;  // the prior's centre
   // The depth the rangefinder implies here (inverse, in the host); 0: none.
   float idepth_range = 0;
-  std::array<float, kPatternSize> intensities{};  // the host's
-  std::array<float, kPatternSize> weights{};      // gradientWeight in the host
-  std::array<Eigen::Vector3f, kPatternSize> rays{};
+  std::array<float, kPatternSize> intensities{};   // the host's
+  std::array<float, kPatternSize> weights{};       // gradientWeight in the host
+  Eigen::Vector3f ray = Eigen::Vector3f::UnitZ();  // through (x, y) in the host, z = 1
   // Set by the optimiser: most of its residual blocks were outliers.
   bool bad = false;
 };
@@ -74,10 +74,10 @@ struct WindowStats {
   int bad_points = 0;
 };
 
-// Fills a point's rays, intensities and weights from its host's level 0
+// Fills a point's ray, intensities and weights from its host's level 0
 // (which needs gradients).
-void preparePoint(WindowPoint& point, const ImagePyramid& host, const PinholeLevel& camera,
-                  double gradient_weight_c);
+void preparePoint(WindowPoint& point, const ImagePyramid& host, const cv::Matx33d& K,
+                  const WindowOptimizerParams& params);
 
 WindowStats optimizeWindow(std::vector<WindowFrame>& frames, std::vector<WindowPoint>& points,
                            const cv::Matx33d& K, const WindowOptimizerParams& params);

@@ -64,7 +64,7 @@ Window makeWindow() {
       const Eigen::Vector3d ray = cam.ray(s.x, s.y).cast<double>();
       p.idepth = static_cast<float>(n.dot(ray) / d);
       p.idepth_prior = p.idepth;
-      preparePoint(p, *w.pyramids[host], cam, WindowOptimizerParams{}.gradient_weight_c);
+      preparePoint(p, *w.pyramids[host], kK, WindowOptimizerParams{});
       w.idepth_true.push_back(p.idepth);
       w.points.push_back(p);
     }
