@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "cli/commands.h"
 #include "run/sweep.h"
@@ -15,15 +16,19 @@ namespace nadir::cli {
 
 void addSweepCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
+  auto tabulate = std::make_shared<bool>(false);
   auto* command = app.add_subcommand(
       "sweep", "Run a grid of parameter values (SWEEP.yaml) as parallel runs; write one table");
   command->add_option("sweep", *path, "the sweep file")->required()->check(CLI::ExistingFile);
-  command->callback([path] {
+  command->add_flag("--tabulate", *tabulate,
+                    "run nothing: write the tables from the cells' metrics.json (after `nadir "
+                    "eval` of each cell, say)");
+  command->callback([path, tabulate] {
     const run::SweepSpec spec = run::loadSweep(*path);
     const bool tty = isatty(STDERR_FILENO) != 0;
     const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
     std::size_t last_done = static_cast<std::size_t>(-1);
-    const auto cells = run::runSweep(spec, self, [tty, &last_done](const run::SweepProgress& p) {
+    const auto progress = [tty, &last_done](const run::SweepProgress& p) {
       // In a log, a line when a cell finishes; on a terminal, one line refreshed in place.
       if (!tty && p.done == last_done) return;
       last_done = p.done;
@@ -34,8 +39,10 @@ void addSweepCommand(CLI::App& app) {
       if (p.done > 0 && p.done < p.total) std::fprintf(stderr, ", about %.0f s to go", eta);
       std::fprintf(stderr, tty ? "   " : "\n");
       std::fflush(stderr);
-    });
-    if (tty) std::fprintf(stderr, "\n");
+    };
+    const std::vector<run::SweepCell> cells =
+        *tabulate ? run::readSweep(spec) : run::runSweep(spec, self, progress);
+    if (tty && !*tabulate) std::fprintf(stderr, "\n");
     const std::filesystem::path out(spec.out_dir);
     std::ofstream(out / "results.csv") << run::sweepCsv(spec, cells);
     const std::string markdown = run::sweepMarkdown(spec, cells);

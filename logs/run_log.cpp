@@ -46,6 +46,7 @@ bool TrajectoryCollector::add(const std::string& channel, const void* data, std:
     SourceEstimate sample;
     sample.t_s = core::stampFromUtime(estimate.utime);
     sample.status = static_cast<int>(estimate.status);
+    sample.resets = estimate.num_resets;
     if (estimate.status == msg::VoStatus::TRACKING) {
       sample.p_ned_m = estimate.p_ned_m;
       sample.q_world_body = estimate.q_world_body;

@@ -29,6 +29,7 @@ struct SourceEstimate : core::StampedPose {
   static constexpr int kTracking = 1;
   static constexpr int kLost = 2;
   int status = kInitializing;
+  int resets = 0;  // the node's num_resets so far
 };
 
 struct LogTrajectories {

@@ -41,6 +41,11 @@ std::vector<std::string> sourceNames(const std::vector<SweepCell>& cells) {
   return {names.begin(), names.end()};
 }
 
+// A source's resets: the count, or "-" where it is not known.
+std::string resetsText(const eval::SourceMetrics& m) {
+  return m.resets ? std::to_string(*m.resets) : "-";
+}
+
 std::string number(double value) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.3f", value);
@@ -173,13 +178,8 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
       }
       SweepCell& cell = cells[it->first];
       cell.exit_status = it->second->exitStatus();
-      const fs::path metrics = fs::path(cell.out_dir) / "metrics.json";
       if (cell.exit_status == 0) {
-        try {
-          cell.metrics = eval::readMetricsJson(metrics.string());
-        } catch (const std::exception& error) {
-          cell.error = error.what();
-        }
+        readCellMetrics(cell);
       } else {
         cell.error = it->second->describeExit() + " (see " + it->second->logPath() + ")";
       }
@@ -196,6 +196,25 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
   return cells;
 }
 
+void readCellMetrics(SweepCell& cell) {
+  const fs::path metrics = fs::path(cell.out_dir) / "metrics.json";
+  if (!fs::exists(metrics)) {
+    cell.error = metrics.string() + " does not exist (the cell has not run, or failed)";
+    return;
+  }
+  try {
+    cell.metrics = eval::readMetricsJson(metrics.string());
+  } catch (const std::exception& error) {
+    cell.error = error.what();
+  }
+}
+
+std::vector<SweepCell> readSweep(const SweepSpec& spec) {
+  std::vector<SweepCell> cells = planSweep(spec);
+  for (SweepCell& cell : cells) readCellMetrics(cell);
+  return cells;
+}
+
 std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
   const std::vector<std::string> sources = sourceNames(cells);
   std::string csv;
@@ -203,7 +222,7 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
   csv += "run,truth_track_length_m";
   for (const std::string& source : sources) {
     csv += "," + source + ".position_rmse_m," + source + ".rotation_rmse_deg," + source +
-           ".tracked_pct";
+           ".tracked_pct," + source + ".resets";
   }
   csv += "\n";
   for (const SweepCell& cell : cells) {
@@ -212,12 +231,12 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
     for (const std::string& source : sources) {
       const eval::SourceMetrics* metrics = sourceOf(cell, source);
       if (metrics == nullptr) {
-        csv += ",,,";
+        csv += ",,,,";
       } else if (!metrics->initialised) {
-        csv += ",X,X," + number(0.0);
+        csv += ",X,X," + number(0.0) + "," + resetsText(*metrics);
       } else {
         csv += "," + number(metrics->position_rmse_m) + "," + number(metrics->rotation_rmse_deg) +
-               "," + number(metrics->tracked_pct);
+               "," + number(metrics->tracked_pct) + "," + resetsText(*metrics);
       }
     }
     csv += "\n";
@@ -241,7 +260,8 @@ std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& c
     }
     line += " track (m) |";
     rule += "---|";
-    for (const char* metric : {"position RMSE (m)", "rotation RMSE (deg)", "tracked (%)"}) {
+    for (const char* metric :
+         {"position RMSE (m)", "rotation RMSE (deg)", "tracked (%)", "resets"}) {
       for (const std::string& source : sources) {
         line.append(" ").append(metric).append(" ").append(source).append(" |");
         rule += "---|";
@@ -256,7 +276,7 @@ std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& c
     }
     if (!cell.metrics) {
       line += " failed |";
-      for (std::size_t i = 0; i < 3 * sources.size(); ++i) line += " failed |";
+      for (std::size_t i = 0; i < 4 * sources.size(); ++i) line += " failed |";
       return line + "\n";
     }
     line.append(" ").append(number(cell.metrics->truth_track_length_m)).append(" |");
@@ -269,11 +289,13 @@ std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& c
         best_rotation = std::min(best_rotation, m->rotation_rmse_deg);
       }
     }
-    for (int metric = 0; metric < 3; ++metric) {
+    for (int metric = 0; metric < 4; ++metric) {
       for (const std::string& source : sources) {
         const eval::SourceMetrics* m = sourceOf(cell, source);
         if (m == nullptr) {
           line += " |";
+        } else if (metric == 3) {
+          line.append(" ").append(resetsText(*m)).append(" |");
         } else if (metric < 2 && !m->initialised) {
           line += " X |";
         } else {

@@ -67,10 +67,16 @@ struct SweepProgress {
 std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_program,
                                 const std::function<void(const SweepProgress&)>& on_progress);
 
+// A finished cell's OUT/metrics.json into cell.metrics, or why not into cell.error.
+void readCellMetrics(SweepCell& cell);
+// The cells of a sweep that has run, from their metrics.json (after `nadir
+// eval` has rewritten them, say), without running anything.
+std::vector<SweepCell> readSweep(const SweepSpec& spec);
+
 // The results: one CSV row per cell, and Markdown tables like the thesis's
 // (one table per value of the first axis when there are three or more axes;
-// rows the other axes; per source position RMSE, rotation RMSE and tracked %,
-// X where a source never initialised, the lowest error of a row in bold).
+// rows the other axes; per source position RMSE, rotation RMSE, tracked % and
+// resets, X where a source never initialised, the lowest error of a row in bold).
 std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells);
 std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells);
 

@@ -81,6 +81,7 @@ Json sourceJson(const SourceMetrics& m) {
   j["estimates_tracking"] = m.estimates_tracking;
   j["estimates_evaluated"] = m.estimates_evaluated;
   j["tracking_segments"] = m.tracking_segments;
+  j["resets"] = m.resets ? Json(*m.resets) : Json(nullptr);
   j["ape"] = Json{{"alignment", m.alignment},
                   {"scale", number(m.alignment_scale)},
                   {"translation_m", statisticsJson(m.ape_translation_m)},
@@ -114,6 +115,15 @@ class JsonReader {
     const Json& value = at(object, key, where);
     if (!value.is_number_unsigned()) fail(where + "." + key, "is not a count");
     return value.get<std::size_t>();
+  }
+  // Absent (older files) or null: none.
+  std::optional<std::size_t> optionalCount(const Json& object, const std::string& key,
+                                           const std::string& where) const {
+    if (!object.is_object()) fail(where, "is not an object");
+    const auto it = object.find(key);
+    if (it == object.end() || it->is_null()) return std::nullopt;
+    if (!it->is_number_unsigned()) fail(where + "." + key, "is not a count");
+    return it->get<std::size_t>();
   }
   std::string text(const Json& object, const std::string& key, const std::string& where) const {
     const Json& value = at(object, key, where);
@@ -165,6 +175,7 @@ SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::stri
   m.estimates_tracking = r.count(j, "estimates_tracking", where);
   m.estimates_evaluated = r.count(j, "estimates_evaluated", where);
   m.tracking_segments = r.count(j, "tracking_segments", where);
+  m.resets = r.optionalCount(j, "resets", where);
   const Json& ape = r.at(j, "ape", where);
   m.alignment = r.text(ape, "alignment", where + ".ape");
   m.alignment_scale = r.number(ape, "scale", where + ".ape");
@@ -209,6 +220,9 @@ SourceMetrics evaluateSource(const core::Trajectory& truth,
   m.rpe_delta = options.rpe_delta;
   m.rpe_delta_unit = options.rpe_delta_unit;
   m.estimates = sorted.size();
+  for (const SourceEstimate& e : sorted)
+    m.resets = std::max<std::size_t>(m.resets.value_or(0),
+                                     static_cast<std::size_t>(std::max(e.resets, 0)));
   if (sorted.size() >= 2 && sorted.back().t_s > sorted.front().t_s) {
     m.rate_hz = static_cast<double>(sorted.size() - 1) / (sorted.back().t_s - sorted.front().t_s);
   }
@@ -412,10 +426,10 @@ std::string formatResultsTable(const RunMetrics& metrics) {
   std::snprintf(line, sizeof line, "truth: %.1f m in %.1f s (%zu poses)\n",
                 metrics.truth_track_length_m, metrics.truth_duration_s, metrics.truth_poses);
   out += line;
-  const char* const row_format = "%-12s %5s %9s %11s %13s %11s %11s %11s %9s %9s %7s %8s\n";
+  const char* const row_format = "%-12s %5s %9s %11s %13s %11s %11s %11s %9s %9s %7s %8s %7s\n";
   std::snprintf(line, sizeof line, row_format, "source", "init", "tracked%", "pos RMSE m",
                 "rot RMSE deg", "APE RMSE m", "RPE RMSE m", "len diff %", "MAE m", "end m", "end %",
-                "rate Hz");
+                "rate Hz", "resets");
   out += line;
   for (const auto& [name, m] : metrics.sources) {
     std::snprintf(line, sizeof line, row_format, name.c_str(), m.initialised ? "yes" : "no",
@@ -424,7 +438,7 @@ std::string formatResultsTable(const RunMetrics& metrics) {
                   cell(m.rpe_translation_m.rmse, 3).c_str(),
                   cell(m.track_length_diff_pct, 2).c_str(), cell(m.mean_abs_error_m, 3).c_str(),
                   cell(m.end_point_m, 3).c_str(), cell(m.end_point_pct, 2).c_str(),
-                  cell(m.rate_hz, 1).c_str());
+                  cell(m.rate_hz, 1).c_str(), m.resets ? std::to_string(*m.resets).c_str() : "-");
     out += line;
   }
   if (metrics.sources.empty()) {

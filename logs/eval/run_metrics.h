@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,10 @@ struct SourceMetrics {
   std::size_t estimates_tracking = 0;   // TRACKING
   std::size_t estimates_evaluated = 0;  // TRACKING and compared with the truth
   std::size_t tracking_segments = 0;    // runs of consecutive TRACKING estimates
-  double first_tracking_s = kNaN;       // first TRACKING stamp minus the truth start, s
+  // The most resets (num_resets) the source reported; none without estimates
+  // or from a metrics.json written before it was recorded.
+  std::optional<std::size_t> resets;
+  double first_tracking_s = kNaN;  // first TRACKING stamp minus the truth start, s
   double rate_hz = kNaN;
   double tracked_pct = 0;
   double position_rmse_m = kNaN;

@@ -292,24 +292,58 @@ TEST(Sweep, TablesLikeTheThesis) {
   eval::RunMetrics metrics;
   metrics.truth_track_length_m = 3203.0;
   metrics.sources["vo_direct"] = sourceMetrics(true, 12.5, 3.25, 97.0);
+  metrics.sources["vo_direct"].resets = 2;
   metrics.sources["vo_feature"] = sourceMetrics(false, 0.0, 0.0, 0.0);
   metrics.sources["ppa"] = sourceMetrics(true, 20.0, 1.5, 100.0);
+  metrics.sources["ppa"].resets = 0;
   cells[0].metrics = metrics;
   cells[1].error = "exit status 1";
   const std::string md = sweepMarkdown(spec, cells);
   EXPECT_NE(md.find("## vehicle.airspeed_mps = 10"), std::string::npos) << md;
   EXPECT_NE(md.find("## vehicle.airspeed_mps = 25"), std::string::npos) << md;
   // Columns in source order: ppa, vo_direct, vo_feature.
+  // Resets: a count, "-" where not known.
   EXPECT_NE(md.find("| 25 | 50 | 3203.000 | 20.000 | **12.500** | X | **1.500** | 3.250 | X | "
-                    "100.000 | 97.000 | 0.000 |"),
+                    "100.000 | 97.000 | 0.000 | 0 | 2 | - |"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| 25 | 50 | failed |"), std::string::npos) << md;
   const std::string csv = sweepCsv(spec, cells);
-  EXPECT_NE(csv.find("10,25,50,ok,3203.000,20.000,1.500,100.000,12.500,3.250,97.000,X,X,0.000"),
+  EXPECT_NE(csv.find("10,25,50,ok,3203.000,20.000,1.500,100.000,0,12.500,3.250,97.000,2,X,X,"
+                     "0.000,-"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find("25,25,50,failed,"), std::string::npos) << csv;
+}
+
+// --tabulate: the cells of a sweep that ran are read back from their
+// metrics.json; a cell without one is named, not mistaken for a result.
+TEST(Sweep, TablesFromTheCellsThatRan) {
+  SweepSpec spec;
+  spec.scenario = "default";
+  spec.out_dir = tempDir("sweep_tabulate");
+  spec.axes = {{"vehicle.altitude_agl_m", {"100", "200"}}};
+  std::vector<SweepCell> planned = planSweep(spec);
+  eval::RunMetrics metrics;
+  metrics.truth_track_length_m = 500.0;
+  metrics.truth_duration_s = 20.0;
+  metrics.truth_poses = 2000;
+  metrics.sources["vo_direct"] = sourceMetrics(true, 1.25, 0.5, 100.0);
+  metrics.sources["vo_direct"].resets = 1;
+  fs::create_directories(planned[0].out_dir);
+  eval::writeMetricsJson((fs::path(planned[0].out_dir) / "metrics.json").string(), metrics,
+                         eval::EvalOptions{});
+  const std::vector<SweepCell> cells = readSweep(spec);
+  ASSERT_EQ(cells.size(), 2u);
+  ASSERT_TRUE(cells[0].metrics.has_value()) << cells[0].error;
+  EXPECT_EQ(cells[0].metrics->sources.at("vo_direct").position_rmse_m, 1.25);
+  EXPECT_EQ(cells[0].metrics->sources.at("vo_direct").resets, std::optional<std::size_t>(1));
+  EXPECT_FALSE(cells[1].metrics.has_value());
+  EXPECT_NE(cells[1].error.find("metrics.json does not exist"), std::string::npos)
+      << cells[1].error;
+  EXPECT_NE(sweepMarkdown(spec, cells).find("| 100 | 500.000 | 1.250 | 0.500 | 100.000 | 1 |"),
+            std::string::npos)
+      << sweepMarkdown(spec, cells);
 }
 
 // Live: the nodes start as processes, the scenario ends, every node stops cleanly, the

@@ -69,6 +69,20 @@ TEST(EvalRunMetrics, GapInTrackingGivesHandTrackedPct) {
   EXPECT_EQ(m.rpe_translation_m.count, 29u + 49u);  // pairs never straddle the gap
 }
 
+// A node's num_resets is a running count: the source's resets are the largest
+// it reported (here 0, then 1 from 4.0 s, then 2 from 7.0 s), whatever the order
+// the estimates arrive in; a source with no estimates has none.
+TEST(EvalRunMetrics, ResetsAreTheLargestCountReported) {
+  auto estimates = estimatesAt10Hz(0, [](int) { return SourceEstimate::kTracking; });
+  for (std::size_t k = 0; k < estimates.size(); ++k) estimates[k].resets = k >= 70 ? 2 : k >= 40;
+  std::swap(estimates.front(), estimates.back());
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  ASSERT_TRUE(m.resets.has_value());
+  EXPECT_EQ(*m.resets, 2u);
+  const SourceMetrics none = evaluateSource(straightTruth(), {}, EvalOptions{});
+  EXPECT_FALSE(none.resets.has_value());
+}
+
 // Starting to track at 2.0 s counts the first 2 s as not tracked: 80 %.
 TEST(EvalRunMetrics, LateStartIsNotTracked) {
   const auto estimates = estimatesAt10Hz(20, [](int) { return SourceEstimate::kTracking; });
@@ -204,6 +218,7 @@ TEST(EvalMetricsJson, RoundTrip) {
     return k >= 30 && k < 50 ? SourceEstimate::kLost : SourceEstimate::kTracking;
   });
   for (SourceEstimate& e : sources["vo_feature"]) e.p_ned_m.y() += 0.1 * std::sin(e.t_s);
+  for (SourceEstimate& e : sources["vo_feature"]) e.resets = e.t_s >= 5.0 ? 3 : 0;
   sources["vo_direct"] = estimatesAt10Hz(0, [](int) { return SourceEstimate::kInitializing; });
   EvalOptions options;
   options.align = "none";
@@ -247,6 +262,7 @@ TEST(EvalMetricsJson, RoundTrip) {
     EXPECT_EQ(r.rpe_delta_unit, w.rpe_delta_unit);
     EXPECT_EQ(r.estimates_evaluated, w.estimates_evaluated);
     EXPECT_EQ(r.tracking_segments, w.tracking_segments);
+    EXPECT_EQ(r.resets, w.resets);
     EXPECT_EQ(r.note, w.note);
     expectSame(r.ape_translation_m, w.ape_translation_m);
     expectSame(r.ape_rotation_deg, w.ape_rotation_deg);
@@ -254,6 +270,19 @@ TEST(EvalMetricsJson, RoundTrip) {
     expectSame(r.rpe_rotation_deg, w.rpe_rotation_deg);
   }
   EXPECT_GT(read.sources.at("vo_feature").rpe_translation_m.count, 0u);
+  EXPECT_EQ(read.sources.at("vo_feature").resets, std::optional<std::size_t>(3));
+  EXPECT_EQ(read.sources.at("vo_direct").resets, std::optional<std::size_t>(0));
+
+  // A metrics.json from before resets were recorded reads as "not known".
+  std::string old_text = text.str();
+  for (std::size_t at; (at = old_text.find("\"resets\"")) != std::string::npos;)
+    old_text.erase(at, old_text.find('\n', at) - at + 1);
+  const std::string old_path = tempPath("old_metrics.json");
+  std::ofstream(old_path) << old_text;
+  for (const auto& [name, r] : readMetricsJson(old_path).sources) {
+    SCOPED_TRACE(name);
+    EXPECT_FALSE(r.resets.has_value());
+  }
 
   // The table has one row per source and "-" for what does not exist.
   const std::string table = formatResultsTable(read);
