@@ -44,6 +44,25 @@ inline PatternOffsets rotatedPatternOffsets(const PinholeLevel& camera, const Ei
   return out;
 }
 
+// A point's pattern seen from another camera: qc is its centre ray turned
+// and moved there (R c + rho t), offsets the turned pattern. Fills the pixels
+// and says whether every one lies in front of the camera and inside
+// [margin, x_max) x [margin, y_max); u and v are filled up to the first that does not.
+inline bool projectPattern(const Eigen::Vector3f& qc, const PatternOffsets& offsets,
+                           const PinholeLevel& camera, float margin, float x_max, float y_max,
+                           std::array<float, kPatternSize>& u, std::array<float, kPatternSize>& v) {
+  if (qc.z() <= 1e-6f) return false;
+  for (int i = 0; i < kPatternSize; ++i) {
+    const Eigen::Vector3f q = qc + offsets[i];
+    if (q.z() <= 1e-6f) return false;
+    const float iz = 1.f / q.z();
+    u[i] = camera.fx * q.x() * iz + camera.cx;
+    v[i] = camera.fy * q.y() * iz + camera.cy;
+    if (!(u[i] >= margin && v[i] >= margin && u[i] < x_max && v[i] < y_max)) return false;
+  }
+  return true;
+}
+
 // The weight of a pixel by the reference's gradient there, c^2 / (c^2 +
 // |grad|^2): on strong edges a small misalignment or blur makes large
 // residuals. Taken from the reference (key-frame, host), not from the image

@@ -176,8 +176,8 @@ class DirectVo {
   // next frame cannot, it is made again there (the same loss, no new reset).
   bool unconfirmed_ = false;
   double typical_rms_ = 0.0;  // 0: none yet for this map
-  double selection_cell_px_ =
-      0.0;  // the last key-frame's selection cell: the next one starts there
+  // The last key-frame's pixel-selection cell size: the next selection starts there.
+  double selection_cell_px_ = 0.0;
   int resets_ = 0;
 
   DirectVoTiming timing_;

@@ -175,19 +175,7 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
     if (!select && !active[pi]) continue;
     const Eigen::Vector3f qc = R * p.ray + p.idepth * t;
     std::array<float, kPatternSize> u, v;
-    bool inside = qc.z() > 1e-6f;
-    for (int i = 0; i < kPatternSize && inside; ++i) {
-      const Eigen::Vector3f q = qc + offsets[i];
-      if (q.z() <= 1e-6f) {
-        inside = false;
-        break;
-      }
-      const float iz = 1.f / q.z();
-      u[i] = cam.fx * q.x() * iz + cam.cx;
-      v[i] = cam.fy * q.y() * iz + cam.cy;
-      inside = u[i] >= margin && v[i] >= margin && u[i] < x_max && v[i] < y_max;
-    }
-    if (!inside) {
+    if (!projectPattern(qc, offsets, cam, margin, x_max, y_max, u, v)) {
       if (!select) sys.energy += oob_penalty;
       continue;
     }

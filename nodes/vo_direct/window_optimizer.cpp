@@ -241,19 +241,8 @@ class Optimizer {
         const float y_max = static_cast<float>(samples.rows - 1) - margin;
         const Eigen::Vector3f qc = Rth * p.ray + rho * tth;
         std::array<float, kPatternSize> u, v;
-        bool inside = rho > 0.f && qc.z() > 1e-6f;
-        for (int i = 0; i < kPatternSize && inside; ++i) {
-          const Eigen::Vector3f q = qc + offsets[pair][i];
-          if (q.z() <= 1e-6f) {
-            inside = false;
-            break;
-          }
-          const float iz = 1.f / q.z();
-          u[i] = camera_.fx * q.x() * iz + camera_.cx;
-          v[i] = camera_.fy * q.y() * iz + camera_.cy;
-          inside = u[i] >= margin && v[i] >= margin && u[i] < x_max && v[i] < y_max;
-        }
-        if (!inside) {
+        if (!(rho > 0.f) ||
+            !projectPattern(qc, offsets[pair], camera_, margin, x_max, y_max, u, v)) {
           if (!first) sys.energy += oob_penalty;  // it was in the image at the start
           continue;
         }
