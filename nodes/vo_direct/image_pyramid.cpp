@@ -40,6 +40,7 @@ void ImagePyramid::computeGradients(int level) {
   const cv::Mat& I = intensity_[level];
   cv::Mat& out = samples_[level];
   out.create(I.rows, I.cols, CV_32FC3);
+  if (level == 0) I.convertTo(level0_bytes_, CV_8U);
   for (int y = 0; y < I.rows; ++y) {
     const float* row = I.ptr<float>(y);
     const float* up = I.ptr<float>(std::max(y - 1, 0));

@@ -233,6 +233,7 @@ class Optimizer {
         const Eigen::Matrix3f& Rth = R[pair];
         const Eigen::Vector3f& tth = t[pair];
         const cv::Mat& samples = frames_[g].pyramid->samples(0);
+        const cv::Mat& bytes = frames_[g].pyramid->level0Bytes();
         // A block joins only well inside the image, so that the small moves of
         // the optimisation rarely take it out (it then costs the Huber cost
         // of a residual at the threshold per pixel).
@@ -255,7 +256,7 @@ class Optimizer {
         std::array<float, kPatternSize> r, mean;
         float raw2 = 0.f;
         for (int i = 0; i < kPatternSize; ++i) {
-          smp[i] = ImagePyramid::sample(samples, u[i], v[i]);
+          smp[i] = ImagePyramid::sampleLevel0(bytes, samples, u[i], v[i]);
           const float seen = inv_half_gain * (smp[i].intensity - b_t);
           const float expected = half_gain * (p.intensities[i] - b_h);
           r[i] = seen - expected;
