@@ -18,6 +18,7 @@
 #include "nadir/heartbeat_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
+#include "nadir/magnetometer_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/ppa_odometry_t.hpp"
 #include "nadir/range_t.hpp"
@@ -233,6 +234,10 @@ struct LcmOf<Baro> {
   using type = nadir::baro_t;
 };
 template <>
+struct LcmOf<Magnetometer> {
+  using type = nadir::magnetometer_t;
+};
+template <>
 struct LcmOf<GeodeticPosition> {
   using type = nadir::geodetic_position_t;
 };
@@ -353,6 +358,13 @@ Bytes encode(const Baro& message) {
   out.utime = message.utime;
   out.altitude_m = message.altitude_m;
   out.pressure_pa = message.pressure_pa;
+  return toBytes(out);
+}
+
+Bytes encode(const Magnetometer& message) {
+  nadir::magnetometer_t out{};
+  out.utime = message.utime;
+  put3(message.field_body_ut, out.field_ut);
   return toBytes(out);
 }
 
@@ -571,6 +583,12 @@ Baro decode<Baro>(const void* data, std::size_t size) {
 }
 
 template <>
+Magnetometer decode<Magnetometer>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::magnetometer_t>(data, size);
+  return {in.utime, get3(in.field_ut)};
+}
+
+template <>
 GeodeticPosition decode<GeodeticPosition>(const void* data, std::size_t size) {
   const auto in = fromBytes<nadir::geodetic_position_t>(data, size);
   const std::string at = where(in);
@@ -742,6 +760,7 @@ NADIR_MSG_TYPE(Imu)
 NADIR_MSG_TYPE(Range)
 NADIR_MSG_TYPE(Gps)
 NADIR_MSG_TYPE(Baro)
+NADIR_MSG_TYPE(Magnetometer)
 NADIR_MSG_TYPE(GeodeticPosition)
 NADIR_MSG_TYPE(Attitude)
 NADIR_MSG_TYPE(Velocity)
@@ -758,10 +777,10 @@ NADIR_MSG_TYPE(Heartbeat)
 std::string typeName(const void* data, std::size_t size) {
   static const std::vector<KnownType> kTypes =
       knownTypes<nadir::pose_t, nadir::imu_t, nadir::range_t, nadir::gps_t, nadir::baro_t,
-                 nadir::geodetic_position_t, nadir::attitude_t, nadir::velocity_t,
-                 nadir::body_rates_t, nadir::camera_info_t, nadir::image_t, nadir::vo_estimate_t,
-                 nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
-                 nadir::heartbeat_t>();
+                 nadir::magnetometer_t, nadir::geodetic_position_t, nadir::attitude_t,
+                 nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t, nadir::image_t,
+                 nadir::vo_estimate_t, nadir::ppa_odometry_t, nadir::target_detection_t,
+                 nadir::vo_command_t, nadir::heartbeat_t>();
   const std::int64_t hash = fingerprintOf(data, size);
   for (const KnownType& type : kTypes) {
     if (type.hash == hash) return type.name;

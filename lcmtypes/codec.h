@@ -37,6 +37,7 @@ Bytes encode(const Imu& message);
 Bytes encode(const Range& message);
 Bytes encode(const Gps& message);
 Bytes encode(const Baro& message);
+Bytes encode(const Magnetometer& message);
 Bytes encode(const GeodeticPosition& message);
 Bytes encode(const Attitude& message);
 Bytes encode(const Velocity& message);

@@ -74,6 +74,12 @@ struct Baro {
   double pressure_pa = 0.0;
 };
 
+// magnetometer_t: the magnetic field in the body frame.
+struct Magnetometer {
+  std::int64_t utime = 0;
+  Eigen::Vector3d field_body_ut = Eigen::Vector3d::Zero();
+};
+
 // geodetic_position_t (NAV_POSITION): WGS-84, ellipsoid height; altitude_rel_m
 // above the start.
 struct GeodeticPosition {

@@ -288,4 +288,44 @@ double standardAtmospherePressure_pa(double altitude_m) {
   return 22632.06 * std::exp(-1.576883e-4 * (altitude_m - kTropopause_m));
 }
 
+// ---------------------------------------------------------------- magnetometer
+
+void MagnetometerParams::visit(core::ParamVisitor& v) {
+  v.field("rate_hz", &rate_hz, {.doc = "sample rate, Hz", .min = 0.1, .max = 1000});
+  v.field("seed", &seed, {.doc = "noise seed", .min = 0, .max = kMaxSeed});
+  v.field("declination_deg", &declination_deg,
+          {.doc = "the field's declination, east of true north, deg", .min = -180, .max = 180});
+  v.field("inclination_deg", &inclination_deg,
+          {.doc = "the field's inclination, below the horizon, deg", .min = -90, .max = 90});
+  v.field("field_ut", &field_ut, {.doc = "the field's strength, uT", .min = 1, .max = 1000});
+  v.field("noise_sigma_ut", &noise_sigma_ut,
+          {.doc = "white noise per axis, 1-sigma, uT", .min = 0, .max = 100});
+  v.field("hard_iron_ut", &hard_iron_ut,
+          {.doc = "uncalibrated airframe field, body FRD, uT",
+           .min = -1000,
+           .max = 1000,
+           .list_size = 3});
+}
+
+Eigen::Vector3d earthField_ned_ut(const MagnetometerParams& params) {
+  constexpr double kRad = std::numbers::pi / 180.0;
+  const double d = params.declination_deg * kRad, i = params.inclination_deg * kRad;
+  return params.field_ut *
+         Eigen::Vector3d(std::cos(i) * std::cos(d), std::cos(i) * std::sin(d), std::sin(i));
+}
+
+MagnetometerModel::MagnetometerModel(const MagnetometerParams& params)
+    : params_(validated(params, "magnetometer")),
+      field_ned_ut_(earthField_ned_ut(params_)),
+      hard_iron_ut_(vector3(params_.hard_iron_ut)),
+      noise_(static_cast<std::uint64_t>(params_.seed)) {}
+
+MagSample MagnetometerModel::sample(const VehicleState& state) {
+  MagSample out;
+  out.utime = state.utime;
+  out.field_body_ut = state.q_world_body.conjugate() * field_ned_ut_ + hard_iron_ut_ +
+                      normal3(noise_, params_.noise_sigma_ut);
+  return out;
+}
+
 }  // namespace nadir::sim

@@ -1,5 +1,6 @@
 #pragma once
-// Sensor models of the simulator: IMU, rangefinder, GPS and barometer. Plain
+// Sensor models of the simulator: IMU, rangefinder, GPS, barometer and
+// magnetometer. Plain
 // structs in, the messages' plain structs (lcmtypes/messages.h) out, no LCM.
 //
 // Every model is deterministic: it owns a std::mt19937_64 seeded from its
@@ -38,8 +39,10 @@ struct ImuParams {
   double accel_noise_density_mps2_rthz = 2.0e-3;
   double gyro_bias_random_walk_rps_rts = 2.0e-5;
   double accel_bias_random_walk_mps2_rts = 2.0e-4;
-  std::vector<double> gyro_initial_bias_rps = {0.0, 0.0, 0.0};
-  std::vector<double> accel_initial_bias_mps2 = {0.0, 0.0, 0.0};
+  // What a MEMS IMU keeps after its calibration at power-on: a few hundredths
+  // of a deg/s and a few mg.
+  std::vector<double> gyro_initial_bias_rps = {0.0012, -0.0009, 0.0007};
+  std::vector<double> accel_initial_bias_mps2 = {0.06, -0.04, 0.08};
 
   void visit(core::ParamVisitor& v);
 };
@@ -196,6 +199,44 @@ class BarometerModel {
   double bias_m_;
   bool has_previous_ = false;
   std::int64_t previous_utime_ = 0;
+};
+
+// ---------------------------------------------------------------- magnetometer
+
+// The Earth's field as a constant over the flight (a few km of the World
+// Magnetic Model's field differ by far less than a sensor's errors). The
+// defaults are central Indiana's (the area of Kim (2019)'s flights), 2025.
+struct MagnetometerParams {
+  double rate_hz = 50.0;
+  std::int64_t seed = 5;
+  double declination_deg = -4.6;  // east of true north positive
+  double inclination_deg = 66.5;  // below the horizon positive
+  double field_ut = 52.0;
+  double noise_sigma_ut = 0.3;
+  // What calibration leaves of the airframe's own field, body FRD, uT.
+  std::vector<double> hard_iron_ut = {0.6, -0.4, 0.5};
+
+  void visit(core::ParamVisitor& v);
+};
+
+using MagSample = msg::Magnetometer;
+
+// The field in NED, F (cos I cos D, cos I sin D, sin I).
+Eigen::Vector3d earthField_ned_ut(const MagnetometerParams& params);
+
+// R_world_body^T times the Earth's field, plus the hard-iron offset and white noise.
+class MagnetometerModel {
+ public:
+  // Throws core::ParamError if a parameter is out of its range.
+  explicit MagnetometerModel(const MagnetometerParams& params);
+
+  MagSample sample(const VehicleState& state);
+
+ private:
+  MagnetometerParams params_;
+  Eigen::Vector3d field_ned_ut_;
+  Eigen::Vector3d hard_iron_ut_;
+  GaussianNoise noise_;
 };
 
 }  // namespace nadir::sim

@@ -64,13 +64,12 @@ void SimPublisher::publish(const SimOutput& output) {
   if (output.range) send(sensors.rangefinder.channel, *output.range);
   if (output.gps) send(sensors.gps.channel, *output.gps);
   if (output.baro) send(sensors.barometer.channel, *output.baro);
-  if (output.nav_due) {
-    const NavMessages nav =
-        toNavMessages(output.truth, simulator_.frame(), simulator_.startAltitude_m());
-    send(params_.truth.nav_position_channel, nav.position);
-    send(params_.truth.nav_attitude_channel, nav.attitude);
-    send(params_.truth.nav_velocity_channel, nav.velocity);
-    send(params_.truth.nav_rates_channel, nav.rates);
+  if (output.mag) send(sensors.magnetometer.channel, *output.mag);
+  if (output.nav) {
+    send(params_.truth.nav_position_channel, output.nav->position);
+    send(params_.truth.nav_attitude_channel, output.nav->attitude);
+    send(params_.truth.nav_velocity_channel, output.nav->velocity);
+    send(params_.truth.nav_rates_channel, output.nav->rates);
   }
 }
 

@@ -73,6 +73,8 @@ void SensorsParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "rangefinder", "distance along a body ray to the terrain", rangefinder);
   core::visitGroup(v, "gps", "GNSS fixes", gps);
   core::visitGroup(v, "barometer", "barometric altitude", barometer);
+  core::visitGroup(v, "magnetometer", "the Earth's magnetic field in the body", magnetometer);
+  core::visitGroup(v, "ahrs", "the flight controller's estimate on NAV_*", ahrs);
 }
 
 void SimParams::visit(core::ParamVisitor& v) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/params.h"
+#include "nodes/sim/flight_estimator.h"
 #include "nodes/sim/sensors.h"
 #include "nodes/sim/vehicles.h"
 #include "terrain/world_factory.h"
@@ -111,6 +112,9 @@ struct SensorsParams {
   SensorSpec<RangefinderParams> rangefinder{.enabled = true, .channel = "RANGE", .model = {}};
   SensorSpec<GpsParams> gps{.enabled = true, .channel = "GPS", .model = {}};
   SensorSpec<BarometerParams> barometer{.enabled = true, .channel = "BARO", .model = {}};
+  SensorSpec<MagnetometerParams> magnetometer{.enabled = true, .channel = "MAG", .model = {}};
+  // What publishes NAV_*: a flight controller's filters on these sensors, or the truth.
+  AhrsParams ahrs;
 
   void visit(core::ParamVisitor& v);
 };

@@ -104,6 +104,28 @@ Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::Wor
   if (sensors.rangefinder.enabled) rangefinder_.emplace(sensors.rangefinder.model);
   if (sensors.gps.enabled) gps_.emplace(sensors.gps.model);
   if (sensors.barometer.enabled) barometer_.emplace(sensors.barometer.model);
+  if (sensors.magnetometer.enabled) magnetometer_.emplace(sensors.magnetometer.model);
+  if (!sensors.ahrs.ideal()) {
+    if (!sensors.imu.enabled || !sensors.magnetometer.enabled) {
+      throw core::ParamError(
+          "sensors.ahrs.estimator: complementary needs sensors.imu.enabled and "
+          "sensors.magnetometer.enabled (or set sensors.ahrs.estimator: ideal)");
+    }
+    estimator_.emplace(sensors.ahrs, frame_);
+  }
+}
+
+NavMessages Simulator::navMessages(const VehicleState& truth) const {
+  NavMessages nav = toNavMessages(truth, frame_, start_altitude_m_);
+  if (!estimator_) return nav;
+  VehicleState estimate = truth;
+  estimate.q_world_body = estimator_->q_world_body();
+  estimate.omega_body_rps = estimator_->rates_body_rps();
+  if (gps_ && estimator_->hasPosition()) {
+    estimate.p_ned_m = estimator_->p_ned_m();
+    estimate.v_ned_mps = estimator_->v_ned_mps();
+  }
+  return toNavMessages(estimate, frame_, start_altitude_m_);
 }
 
 VehicleState Simulator::currentState() const {
@@ -171,8 +193,19 @@ SimOutput Simulator::step() {
   if (barometer_ && core::due(t, params_.sensors.barometer.model.rate_hz, baro_due_)) {
     out.baro = barometer_->sample(out.truth, frame_);
   }
-  out.nav_due =
-      params_.truth.nav_rate_hz > 0.0 && core::due(t, params_.truth.nav_rate_hz, nav_due_);
+  if (magnetometer_ && core::due(t, params_.sensors.magnetometer.model.rate_hz, mag_due_)) {
+    out.mag = magnetometer_->sample(out.truth);
+  }
+  if (estimator_) {
+    if (out.imu) estimator_->addImu(*out.imu);
+    if (out.mag) estimator_->addMagnetometer(*out.mag);
+    if (out.gps) estimator_->addGps(*out.gps);
+    if (out.baro) estimator_->addBaro(*out.baro);
+  }
+  if (params_.truth.nav_rate_hz > 0.0 && core::due(t, params_.truth.nav_rate_hz, nav_due_) &&
+      (!estimator_ || estimator_->hasAttitude())) {
+    out.nav = navMessages(out.truth);
+  }
   return out;
 }
 

@@ -12,7 +12,9 @@
 #include <Eigen/Core>
 
 #include "core/geodesy.h"
+#include "nodes/sim/flight_estimator.h"
 #include "nodes/sim/flight_replay.h"
+#include "nodes/sim/nav_truth.h"
 #include "nodes/sim/sensors.h"
 #include "nodes/sim/sim_params.h"
 #include "nodes/sim/vehicles.h"
@@ -40,8 +42,10 @@ struct SimOutput {
   std::optional<RangeSample> range;
   std::optional<GpsSample> gps;
   std::optional<BaroSample> baro;
-  // The NAV_* channels are due (at truth.nav_rate_hz).
-  bool nav_due = false;
+  std::optional<MagSample> mag;
+  // The NAV_* messages, when due (at truth.nav_rate_hz): the flight
+  // controller's estimate (sensors.ahrs), or the truth with ideal.
+  std::optional<NavMessages> nav;
 };
 
 class Simulator {
@@ -49,7 +53,8 @@ class Simulator {
   // With a flight, it is the truth from its first to its last pose (the vehicle
   // and route are not used); else the vehicle of params.vehicle.kind flies the
   // route. Throws core::ParamError for parameters that cannot be flown (an
-  // unreachable waypoint among them), naming the key.
+  // unreachable waypoint among them) or an estimator without its sensors,
+  // naming the key.
   Simulator(const SimParams& params, std::shared_ptr<const terrain::World> world,
             const core::LocalNedFrame& frame, std::optional<FlightReplay> flight = std::nullopt);
 
@@ -64,10 +69,13 @@ class Simulator {
   double startAltitude_m() const { return start_altitude_m_; }
   const ResolvedRoute& route() const { return route_; }
   const core::LocalNedFrame& frame() const { return frame_; }
+  // The flight controller's filters; empty with sensors.ahrs.estimator ideal.
+  const std::optional<FlightEstimator>& estimator() const { return estimator_; }
 
  private:
   VehicleState currentState() const;
   bool vehicleFinished() const;
+  NavMessages navMessages(const VehicleState& truth) const;
 
   SimParams params_;
   std::shared_ptr<const terrain::World> world_;
@@ -85,10 +93,13 @@ class Simulator {
   std::optional<RangefinderModel> rangefinder_;
   std::optional<GpsModel> gps_;
   std::optional<BarometerModel> barometer_;
+  std::optional<MagnetometerModel> magnetometer_;
+  std::optional<FlightEstimator> estimator_;
   std::int64_t imu_due_ = core::kDueAtFirstCall;
   std::int64_t range_due_ = core::kDueAtFirstCall;
   std::int64_t gps_due_ = core::kDueAtFirstCall;
   std::int64_t baro_due_ = core::kDueAtFirstCall;
+  std::int64_t mag_due_ = core::kDueAtFirstCall;
   std::int64_t nav_due_ = core::kDueAtFirstCall;
 };
 

@@ -21,6 +21,7 @@
 #include "nadir/gps_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
+#include "nadir/magnetometer_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/range_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
@@ -131,7 +132,8 @@ TEST(Codec, InvalidPoseIsRefused) {
 
 // ---------------------------------------------------------------- sensors
 
-// imu_t, range_t, gps_t and baro_t carry every field, the enums mapped to the wire's.
+// imu_t, range_t, gps_t, baro_t and magnetometer_t carry every field, the enums mapped to the
+// wire's.
 TEST(Codec, SensorMessagesCarryEveryField) {
   const Imu imu_sample{7, {0.1, -0.2, 0.3}, {0.5, 0.25, -9.80665}};
   const nadir::imu_t imu = asLcm<nadir::imu_t>(encode(imu_sample));
@@ -194,6 +196,15 @@ TEST(Codec, SensorMessagesCarryEveryField) {
   EXPECT_EQ(baro.utime, 123456);
   EXPECT_EQ(baro.altitude_m, 1000.0);
   EXPECT_EQ(baro.pressure_pa, 89874.6);
+
+  const Bytes mag_bytes = encode(Magnetometer{2345, {20.5, -1.75, 47.25}});
+  const nadir::magnetometer_t mag = asLcm<nadir::magnetometer_t>(mag_bytes);
+  EXPECT_EQ(mag.utime, 2345);
+  EXPECT_EQ(mag.field_ut[0], 20.5);
+  EXPECT_EQ(mag.field_ut[1], -1.75);
+  EXPECT_EQ(mag.field_ut[2], 47.25);
+  EXPECT_EQ(decode<Magnetometer>(mag_bytes).field_body_ut, Eigen::Vector3d(20.5, -1.75, 47.25));
+  EXPECT_EQ(typeName(mag_bytes.data(), mag_bytes.size()), "magnetometer_t");
 }
 
 // An enum value the type does not define is refused.

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +57,8 @@ ScenarioParams withoutSensors(ScenarioParams scenario) {
   scenario.sim.sensors.rangefinder.enabled = false;
   scenario.sim.sensors.gps.enabled = false;
   scenario.sim.sensors.barometer.enabled = false;
+  scenario.sim.sensors.magnetometer.enabled = false;
+  scenario.sim.sensors.ahrs.estimator = "ideal";
   return scenario;
 }
 
@@ -256,19 +259,76 @@ TEST(Scenario, SameSeedSameStreams) {
 TEST(Scenario, SensorRates) {
   const ScenarioParams scenario = loadScenario("default", {"duration_s=10"});
   const Flown flown = fly(scenario, true);
-  int imu = 0, range = 0, gps = 0, baro = 0, nav = 0;
+  int imu = 0, range = 0, gps = 0, baro = 0, mag = 0, nav = 0;
   for (const sim::SimOutput& output : flown.outputs) {
     imu += output.imu.has_value();
+    mag += output.mag.has_value();
     range += output.range.has_value();
     gps += output.gps.has_value();
     baro += output.baro.has_value();
-    nav += output.nav_due;
+    nav += output.nav.has_value();
   }
   EXPECT_EQ(imu, 200 * 10 + 1);
   EXPECT_EQ(range, 50 * 10 + 1);
   EXPECT_EQ(gps, 5 * 10 + 1);
   EXPECT_EQ(baro, 50 * 10 + 1);
+  EXPECT_EQ(mag, 50 * 10 + 1);
   EXPECT_EQ(nav, 50 * 10 + 1);
+}
+
+// NAV_* are the flight controller's estimate by default: near the truth (a
+// few tenths of a degree of tilt, a few degrees of heading, metres of
+// position) but not the truth; with sensors.ahrs.estimator=ideal, the truth.
+TEST(Scenario, NavIsTheFlightControllersEstimateUnlessIdeal) {
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  for (const bool ideal : {false, true}) {
+    ScenarioParams scenario = loadScenario("default", {"duration_s=30"});
+    if (ideal) scenario.sim.sensors.ahrs.estimator = "ideal";
+    const Flown flown = fly(scenario, true);
+    const core::LocalNedFrame frame(terrain::makeWorld(scenario.world).origin);
+    double tilt2 = 0.0, heading2 = 0.0, position2 = 0.0;
+    int n = 0;
+    for (const sim::SimOutput& output : flown.outputs) {
+      if (!output.nav) continue;
+      const Eigen::Quaterniond& q_truth = output.truth.q_world_body;
+      const Eigen::Quaterniond& q_nav = output.nav->attitude.q_world_body;
+      const Eigen::Vector3d down_truth = q_truth.conjugate() * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d down_nav = q_nav.conjugate() * Eigen::Vector3d::UnitZ();
+      tilt2 += std::pow(std::acos(std::clamp(down_truth.dot(down_nav), -1.0, 1.0)) * kDeg, 2);
+      heading2 += std::pow(
+          std::remainder(output.nav->attitude.yaw_rad - core::rpyFromQuaternion(q_truth).yaw_rad,
+                         2 * std::numbers::pi) *
+              kDeg,
+          2);
+      const nadir::msg::GeodeticPosition& p = output.nav->position;
+      position2 += (frame.nedFromGeodetic({p.lat_rad, p.lon_rad, p.alt_m}) - output.truth.p_ned_m)
+                       .squaredNorm();
+      ++n;
+    }
+    ASSERT_EQ(n, 50 * 30 + 1);
+    const double tilt_rms = std::sqrt(tilt2 / n), heading_rms = std::sqrt(heading2 / n);
+    const double position_rms = std::sqrt(position2 / n);
+    if (ideal) {
+      EXPECT_LT(tilt_rms, 1e-5);
+      EXPECT_LT(heading_rms, 1e-6);
+      EXPECT_LT(position_rms, 1e-6);
+    } else {
+      EXPECT_GT(tilt_rms, 0.05);
+      EXPECT_LT(tilt_rms, 1.5);
+      EXPECT_GT(heading_rms, 0.2);
+      EXPECT_LT(heading_rms, 5.0);
+      EXPECT_GT(position_rms, 0.1);
+      EXPECT_LT(position_rms, 5.0);
+    }
+  }
+}
+
+// The estimator needs its IMU and magnetometer; without them the key is named.
+TEST(Scenario, AnEstimatorWithoutItsSensorsIsRefused) {
+  const ScenarioParams scenario = loadScenario("default", {"sensors.magnetometer.enabled=false"});
+  const std::string message = paramErrorOf([&] { fly(scenario); });
+  EXPECT_NE(message.find("sensors.ahrs.estimator"), std::string::npos) << message;
+  EXPECT_NE(message.find("sensors.magnetometer.enabled"), std::string::npos) << message;
 }
 
 // An unknown key is refused with the file, line and key named, and the keys known there.

@@ -70,12 +70,17 @@ ImuParams quietImu() {
   params.accel_noise_density_mps2_rthz = 0.0;
   params.gyro_bias_random_walk_rps_rts = 0.0;
   params.accel_bias_random_walk_mps2_rts = 0.0;
+  params.gyro_initial_bias_rps = {0.0, 0.0, 0.0};
+  params.accel_initial_bias_mps2 = {0.0, 0.0, 0.0};
   return params;
 }
 
-// A level IMU at rest: mean (0, 0, -g) and zero rates, per-sample sigma = density * sqrt(rate).
+// A level IMU at rest without biases: mean (0, 0, -g) and zero rates, per-sample
+// sigma = density * sqrt(rate).
 TEST(ImuModel, LevelAtRestMeanAndNoise) {
   ImuParams params;
+  params.gyro_initial_bias_rps = {0.0, 0.0, 0.0};
+  params.accel_initial_bias_mps2 = {0.0, 0.0, 0.0};
   params.rate_hz = 200.0;
   params.gyro_noise_density_rps_rthz = 1e-3;
   params.accel_noise_density_mps2_rthz = 1e-2;

@@ -201,7 +201,7 @@ TEST(SimNode, LcmLoggerRecordsAndLcmLogplayerReplays) {
   const auto [status, output] =
       run(std::string(NADIR_SIM_BIN) +
           " default --set duration_s=4 --set time.speed=1 --set sensors.imu.enabled=false" +
-          " --set 'bus.url=" + url + "'");
+          " --set sensors.ahrs.estimator=ideal" + " --set 'bus.url=" + url + "'");
   waitUntilRecorded(first, "POSE_TRUTH", 4 * 400 + 1);
   kill(logger, SIGINT);
   waitpid(logger, nullptr, 0);
