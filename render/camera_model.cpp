@@ -87,6 +87,19 @@ void CameraParams::visit(core::ParamVisitor& v) {
   v.field("noise_seed", &noise_seed, {.doc = "seed of the per-frame noise"});
   v.field("ground_detail", &ground_detail,
           {.doc = "add texture finer than the imagery for low altitudes"});
+  v.field("motion_blur", &motion_blur,
+          {.doc = "integrate the scene over the exposure along the camera's path"});
+  v.field("exposure_s", &exposure_s, {.doc = "exposure time, s", .min = 0, .max = 1});
+  v.field("motion_blur_samples", &motion_blur_samples,
+          {.doc = "instants the exposure is sampled at", .min = 1, .max = 64});
+  v.field("rolling_shutter", &rolling_shutter,
+          {.doc = "expose the rows one after the other over readout_s"});
+  v.field("readout_s", &readout_s,
+          {.doc = "time from the first row to the last, s", .min = 0, .max = 1});
+  v.field("motion_margin_px", &motion_margin_px,
+          {.doc = "scene drawn this much wider per side for blur and rolling shutter, px",
+           .min = 0,
+           .max = 1024});
 }
 
 CameraIntrinsics CameraParams::intrinsics() const {

@@ -67,9 +67,26 @@ struct CameraParams {
   std::int64_t noise_seed = 1;
   // Sub-imagery texture for low altitudes (off: the imagery alone).
   bool ground_detail = true;
+  // Motion blur: each pixel integrates the scene over exposure_s, sampled at
+  // motion_blur_samples instants along the camera's path.
+  bool motion_blur = false;
+  double exposure_s = 0.005;
+  int motion_blur_samples = 8;
+  // Rolling shutter: row r is exposed readout_s * (r / (height - 1) - 1/2)
+  // after the frame's time (the middle row's).
+  bool rolling_shutter = false;
+  double readout_s = 0.03;
+  // With either on, the scene is drawn this much wider on each side, so that
+  // what moves into the frame during the exposure or readout is there, px.
+  int motion_margin_px = 48;
 
   void visit(core::ParamVisitor& v);
   CameraIntrinsics intrinsics() const;
+  bool modelsMotion() const { return motion_blur || rolling_shutter; }
+  // How far from the frame's time the exposure reaches either way, s.
+  double motionHalfSpan_s() const {
+    return (rolling_shutter ? 0.5 * readout_s : 0.0) + (motion_blur ? 0.5 * exposure_s : 0.0);
+  }
 };
 
 }  // namespace nadir::render

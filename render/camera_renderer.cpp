@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -20,16 +22,13 @@ void main() {
 }
 )";
 
-// Distortion by lookup, then exposure noise: shot noise (variance proportional
-// to the signal) and read noise, from a hash of pixel, frame and seed.
-constexpr const char* kPostFragment = R"(#version 450 core
-uniform sampler2D u_scene;
-uniform sampler2D u_map;
-uniform bool u_distort;
-uniform bool u_gray;
+// Exposure noise: shot noise (variance proportional to the signal) and read
+// noise, from a hash of pixel, frame and seed. Shared by both post passes.
+constexpr const char* kNoise = R"(
 uniform float u_read_noise;
 uniform float u_electrons_per_count;
 uniform uvec2 u_seed;
+uniform bool u_gray;
 out vec4 out_colour;
 
 uint mix32(uint h) {
@@ -49,9 +48,24 @@ float expose(float value01, uvec2 pixel, uint channel) {
   float counts = value01 * 255.0;
   float variance = u_read_noise * u_read_noise;
   if (u_electrons_per_count > 0.0) variance += counts / u_electrons_per_count;
-  counts += sqrt(variance) * gaussian(pixel, channel);
+  if (variance > 0.0) counts += sqrt(variance) * gaussian(pixel, channel);
   return clamp(floor(counts + 0.5), 0.0, 255.0) / 255.0;
 }
+void writeExposed(vec4 colour) {
+  uvec2 p = uvec2(ivec2(gl_FragCoord.xy));
+  if (u_gray) {
+    out_colour = vec4(expose(colour.r, p, 0u), 0.0, 0.0, 1.0);
+  } else {
+    out_colour = vec4(expose(colour.r, p, 0u), expose(colour.g, p, 1u), expose(colour.b, p, 2u), 1.0);
+  }
+}
+)";
+
+// A still camera: distortion by lookup, then the noise.
+constexpr const char* kPostFragment = R"(
+uniform sampler2D u_scene;
+uniform sampler2D u_map;
+uniform bool u_distort;
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
   vec4 colour;
@@ -61,14 +75,112 @@ void main() {
   } else {
     colour = texelFetch(u_scene, pixel, 0);
   }
-  uvec2 p = uvec2(pixel);
-  if (u_gray) {
-    out_colour = vec4(expose(colour.r, p, 0u), 0.0, 0.0, 1.0);
-  } else {
-    out_colour = vec4(expose(colour.r, p, 0u), expose(colour.g, p, 1u), expose(colour.b, p, 2u), 1.0);
-  }
+  writeExposed(colour);
 }
 )";
+
+// A moving camera (rolling shutter, motion blur): a mesh over the output
+// image, a vertex every kMotionGridPx pixels. At each vertex, the ray through
+// it at its row's time meets the ground of the frame time's depth (two Newton
+// steps), and that ground point is seen at the exposure's two ends; the
+// fragments between interpolate those two positions (the warp of a height
+// field is smooth) and average the scene along the line between them.
+constexpr const char* kMotionVertex = R"(#version 450 core
+uniform sampler2D u_depth;
+uniform sampler2D u_map;
+uniform bool u_distort;
+uniform vec3 u_omega;
+uniform vec3 u_velocity;
+uniform float u_readout_s;
+uniform float u_exposure_s;
+uniform vec4 u_scene_k;
+uniform vec4 u_output_k;
+uniform vec2 u_scene_size;
+uniform vec2 u_output_size;
+uniform vec2 u_depth_range;
+uniform int u_grid_px;
+uniform int u_cells_x;
+noperspective out vec2 v_p0;
+noperspective out vec2 v_p1;
+out float v_inside;
+
+// exp([w]x) to third order: within 1e-4 rad of it up to 0.3 rad, far more
+// than a frame's exposure or readout turns.
+mat3 rotationOf(vec3 w) {
+  mat3 K = mat3(0.0, w.z, -w.y, -w.z, 0.0, w.x, w.y, -w.x, 0.0);
+  mat3 K2 = K * K;
+  return mat3(1.0) + K + 0.5 * K2 + (1.0 / 6.0) * (K2 * K);
+}
+vec2 projectScene(vec3 X) {
+  return vec2(u_scene_k.x * X.x / X.z + u_scene_k.z, u_scene_k.y * X.y / X.z + u_scene_k.w);
+}
+float sceneDepth(vec2 px) {
+  ivec2 p = clamp(ivec2(floor(px + 0.5)), ivec2(0), ivec2(u_scene_size) - 1);
+  float d = texelFetch(u_depth, p, 0).r;
+  float n = u_depth_range.x, f = u_depth_range.y;
+  return 2.0 * f * n / ((f + n) - (2.0 * d - 1.0) * (f - n));
+}
+void main() {
+  // Indexed: vertex i of the (cells_x + 1) x (cells_y + 1) grid.
+  ivec2 c = ivec2(gl_VertexID % (u_cells_x + 1), gl_VertexID / (u_cells_x + 1));
+  vec2 window = min(vec2(c * u_grid_px), u_output_size);
+  gl_Position = vec4(window / u_output_size * 2.0 - 1.0, 0.0, 1.0);
+  vec2 pixel = window - 0.5;
+  vec2 xy;
+  v_inside = 1.0;
+  if (u_distort) {
+    vec2 scene_uv = texture(u_map, window / u_output_size).rg;
+    v_inside = scene_uv.x < 0.0 ? 0.0 : 1.0;
+    xy = (scene_uv * u_scene_size - 0.5 - u_scene_k.zw) / u_scene_k.xy;
+  } else {
+    xy = (pixel - u_output_k.zw) / u_output_k.xy;
+  }
+  float t_row = (pixel.y / max(u_output_size.y - 1.0, 1.0) - 0.5) * u_readout_s;
+  vec3 r = vec3(xy, 1.0);
+  mat3 R = rotationOf(u_omega * t_row);
+  vec3 o = u_velocity * t_row;
+  vec3 d = R * r;
+  float s = sceneDepth(projectScene(d)) / d.z;
+  for (int i = 0; i < 2; ++i) {
+    vec3 X = o + s * d;
+    s += (sceneDepth(projectScene(X)) - X.z) / d.z;
+  }
+  vec3 P = s * r;
+  float t0 = t_row - 0.5 * u_exposure_s, t1 = t_row + 0.5 * u_exposure_s;
+  v_p0 = projectScene(u_velocity * t0 + rotationOf(u_omega * t0) * P);
+  v_p1 = projectScene(u_velocity * t1 + rotationOf(u_omega * t1) * P);
+}
+)";
+
+constexpr const char* kMotionFragment = R"(
+uniform sampler2D u_scene;
+uniform vec2 u_scene_size;
+uniform int u_blur_samples;
+noperspective in vec2 v_p0;
+noperspective in vec2 v_p1;
+in float v_inside;
+void main() {
+  vec4 colour = vec4(0.5);
+  if (v_inside > 0.5) {
+    // Instants half a pixel apart along the smear at most (bilinear lookups
+    // fill in between), up to u_blur_samples.
+    int samples = clamp(int(ceil(2.0 * length(v_p1 - v_p0))), 1, u_blur_samples);
+    colour = vec4(0.0);
+    for (int k = 0; k < samples; ++k) {
+      vec2 p = mix(v_p0, v_p1, (float(k) + 0.5) / float(samples));
+      colour += texture(u_scene, (p + 0.5) / u_scene_size);
+    }
+    colour /= float(samples);
+  }
+  writeExposed(colour);
+}
+)";
+
+constexpr int kMotionGridPx = 32;
+
+std::string fragmentSource(const char* body) {
+  return std::string("#version 450 core\n") + kNoise + body;
+}
 
 }  // namespace
 
@@ -121,6 +233,8 @@ CameraRenderer::~CameraRenderer() {
   glDeleteTextures(1, &distortion_map_);
   glDeleteVertexArrays(1, &post_vertex_array_);
   glDeleteProgram(post_program_);
+  glDeleteProgram(motion_program_);
+  glDeleteBuffers(1, &motion_indices_);
 }
 
 void CameraRenderer::createTargets() {
@@ -128,7 +242,7 @@ void CameraRenderer::createTargets() {
   const bool noise =
       params_.read_noise_counts > 0.0 || params_.shot_noise_electrons_per_count > 0.0;
   const bool distort = intrinsics_.hasDistortion();
-  post_pass_ = noise || distort;
+  post_pass_ = noise || distort || params_.modelsMotion();
   scene_intrinsics_ = intrinsics_;
   scene_intrinsics_.distortion = {};
   if (distort) {
@@ -188,17 +302,73 @@ void CameraRenderer::createTargets() {
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, intrinsics_.width, intrinsics_.height, GL_RG, GL_FLOAT,
                     uv.data);
   }
+  if (params_.modelsMotion()) {
+    // Room for what moves into the frame; the distortion map is in scene texture
+    // coordinates, so it is made again for the wider scene.
+    const int m = params_.motion_margin_px;
+    scene_intrinsics_.width += 2 * m;
+    scene_intrinsics_.height += 2 * m;
+    scene_intrinsics_.cx += m;
+    scene_intrinsics_.cy += m;
+    if (distort) {
+      cv::Mat uv(intrinsics_.height, intrinsics_.width, CV_32FC2);
+      for (int v = 0; v < intrinsics_.height; ++v) {
+        for (int u = 0; u < intrinsics_.width; ++u) {
+          const bool inside = map_x_.at<float>(v, u) > -1e5f;
+          map_x_.at<float>(v, u) += inside ? static_cast<float>(m) : 0.f;
+          map_y_.at<float>(v, u) += inside ? static_cast<float>(m) : 0.f;
+          uv.at<cv::Vec2f>(v, u) =
+              inside ? cv::Vec2f(static_cast<float>((map_x_.at<float>(v, u) + 0.5) /
+                                                    scene_intrinsics_.width),
+                                 static_cast<float>((map_y_.at<float>(v, u) + 0.5) /
+                                                    scene_intrinsics_.height))
+                     : cv::Vec2f(-1.0f, -1.0f);
+        }
+      }
+      glBindTexture(GL_TEXTURE_2D, distortion_map_);
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, intrinsics_.width, intrinsics_.height, GL_RG,
+                      GL_FLOAT, uv.data);
+    }
+  }
   scene_ = std::make_unique<Target>(scene_intrinsics_.width, scene_intrinsics_.height, gray, true);
   if (post_pass_) {
     output_ = std::make_unique<Target>(intrinsics_.width, intrinsics_.height, gray, false);
-    post_program_ = linkProgram("camera post-processing", kPostVertex, kPostFragment);
     glGenVertexArrays(1, &post_vertex_array_);
+    post_program_ =
+        linkProgram("camera post-processing", kPostVertex, fragmentSource(kPostFragment));
+    if (params_.modelsMotion()) {
+      motion_program_ = linkProgram("camera motion (rolling shutter, blur)", kMotionVertex,
+                                    fragmentSource(kMotionFragment));
+      // Two triangles per cell of the grid, the vertices shared.
+      motion_cells_x_ = (intrinsics_.width + kMotionGridPx - 1) / kMotionGridPx;
+      const int cells_y = (intrinsics_.height + kMotionGridPx - 1) / kMotionGridPx;
+      std::vector<GLuint> indices;
+      indices.reserve(static_cast<std::size_t>(6 * motion_cells_x_ * cells_y));
+      const auto vertex = [this](int x, int y) {
+        return static_cast<GLuint>(y * (motion_cells_x_ + 1) + x);
+      };
+      for (int y = 0; y < cells_y; ++y) {
+        for (int x = 0; x < motion_cells_x_; ++x) {
+          for (const GLuint i : {vertex(x, y), vertex(x + 1, y), vertex(x + 1, y + 1), vertex(x, y),
+                                 vertex(x + 1, y + 1), vertex(x, y + 1)})
+            indices.push_back(i);
+        }
+      }
+      motion_index_count_ = static_cast<int>(indices.size());
+      glBindVertexArray(post_vertex_array_);
+      glGenBuffers(1, &motion_indices_);
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, motion_indices_);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                   static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)), indices.data(),
+                   GL_STATIC_DRAW);
+      glBindVertexArray(0);
+    }
   }
   checkGl("creating the camera's framebuffers");
 }
 
 RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::int64_t utime,
-                                     bool with_depth) {
+                                     bool with_depth, const CameraMotion& motion) {
   const bool gray = params_.pixel_format == "gray8";
   RenderedImage out;
   out.utime = utime;
@@ -231,31 +401,63 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
 
   Target* result = scene_.get();
   if (post_pass_) {
+    const bool moving = params_.modelsMotion();
+    const GLuint program = moving ? motion_program_ : post_program_;
+    const auto at = [program](const char* name) { return glGetUniformLocation(program, name); };
     glBindFramebuffer(GL_FRAMEBUFFER, output_->framebuffer);
     glViewport(0, 0, output_->width, output_->height);
     glDisable(GL_DEPTH_TEST);
-    glUseProgram(post_program_);
+    glUseProgram(program);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, scene_->colour);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, distortion_map_);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, scene_->depth);
     glActiveTexture(GL_TEXTURE0);
-    glUniform1i(glGetUniformLocation(post_program_, "u_scene"), 0);
-    glUniform1i(glGetUniformLocation(post_program_, "u_map"), 1);
-    glUniform1i(glGetUniformLocation(post_program_, "u_distort"),
-                intrinsics_.hasDistortion() ? 1 : 0);
-    glUniform1i(glGetUniformLocation(post_program_, "u_gray"), gray ? 1 : 0);
-    glUniform1f(glGetUniformLocation(post_program_, "u_read_noise"),
-                static_cast<float>(params_.read_noise_counts));
-    glUniform1f(glGetUniformLocation(post_program_, "u_electrons_per_count"),
+    glUniform1i(at("u_scene"), 0);
+    glUniform1i(at("u_map"), 1);
+    glUniform1i(at("u_depth"), 2);
+    glUniform1i(at("u_distort"), intrinsics_.hasDistortion() ? 1 : 0);
+    glUniform1i(at("u_gray"), gray ? 1 : 0);
+    glUniform1f(at("u_read_noise"), static_cast<float>(params_.read_noise_counts));
+    glUniform1f(at("u_electrons_per_count"),
                 static_cast<float>(params_.shot_noise_electrons_per_count));
     const auto seed = static_cast<std::uint64_t>(params_.noise_seed);
     const auto frame = static_cast<std::uint64_t>(utime);
-    glUniform2ui(glGetUniformLocation(post_program_, "u_seed"),
-                 static_cast<GLuint>(seed ^ (seed >> 32) ^ frame),
+    glUniform2ui(at("u_seed"), static_cast<GLuint>(seed ^ (seed >> 32) ^ frame),
                  static_cast<GLuint>((frame >> 32) ^ (frame * 0x9E3779B9u)));
     glBindVertexArray(post_vertex_array_);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (moving) {
+      const Eigen::Vector3f omega = motion.omega_cam_rps.cast<float>();
+      const Eigen::Vector3f velocity = motion.v_cam_mps.cast<float>();
+      glUniform3f(at("u_omega"), omega.x(), omega.y(), omega.z());
+      glUniform3f(at("u_velocity"), velocity.x(), velocity.y(), velocity.z());
+      glUniform1f(at("u_readout_s"),
+                  params_.rolling_shutter ? static_cast<float>(params_.readout_s) : 0.f);
+      glUniform1f(at("u_exposure_s"),
+                  params_.motion_blur ? static_cast<float>(params_.exposure_s) : 0.f);
+      glUniform1i(at("u_blur_samples"), params_.motion_blur ? params_.motion_blur_samples : 1);
+      glUniform4f(at("u_scene_k"), static_cast<float>(scene_intrinsics_.fx),
+                  static_cast<float>(scene_intrinsics_.fy),
+                  static_cast<float>(scene_intrinsics_.cx),
+                  static_cast<float>(scene_intrinsics_.cy));
+      glUniform4f(at("u_output_k"), static_cast<float>(intrinsics_.fx),
+                  static_cast<float>(intrinsics_.fy), static_cast<float>(intrinsics_.cx),
+                  static_cast<float>(intrinsics_.cy));
+      glUniform2f(at("u_scene_size"), static_cast<float>(scene_->width),
+                  static_cast<float>(scene_->height));
+      glUniform2f(at("u_output_size"), static_cast<float>(output_->width),
+                  static_cast<float>(output_->height));
+      glUniform2f(at("u_depth_range"), static_cast<float>(params_.near_m),
+                  static_cast<float>(params_.far_m));
+      glUniform1i(at("u_grid_px"), kMotionGridPx);
+      glUniform1i(at("u_cells_x"), motion_cells_x_);
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, motion_indices_);
+      glDrawElements(GL_TRIANGLES, motion_index_count_, GL_UNSIGNED_INT, nullptr);
+    } else {
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
     glBindVertexArray(0);
     result = output_.get();
   }
@@ -272,6 +474,9 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
     if (intrinsics_.hasDistortion()) {
       cv::remap(scene_depth, out.depth_m, map_x_, map_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
                 cv::Scalar(std::numeric_limits<float>::infinity()));
+    } else if (params_.modelsMotion()) {
+      const int m = params_.motion_margin_px;
+      out.depth_m = scene_depth(cv::Rect(m, m, intrinsics_.width, intrinsics_.height)).clone();
     } else {
       out.depth_m = scene_depth;
     }

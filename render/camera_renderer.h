@@ -1,6 +1,7 @@
 #pragma once
 // A virtual camera: renders the terrain from a pose into an offscreen
-// framebuffer, applies lens distortion and sensor noise, and reads the image
+// framebuffer, applies motion blur, rolling shutter, lens distortion and
+// sensor noise, and reads the image
 // (and optionally per-pixel depth) back. Deterministic: the same pose, utime
 // and parameters give bit-identical images.
 
@@ -14,6 +15,13 @@
 #include "render/terrain_renderer.h"
 
 namespace nadir::render {
+
+// The camera's motion about the frame's time, in its optical frame: the pose
+// at time t from the frame's is T_frame_t = (exp(t omega), t v).
+struct CameraMotion {
+  Eigen::Vector3d omega_cam_rps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_cam_mps = Eigen::Vector3d::Zero();
+};
 
 struct RenderedImage {
   std::int64_t utime = 0;
@@ -34,8 +42,10 @@ class CameraRenderer {
   CameraRenderer(const CameraRenderer&) = delete;
   CameraRenderer& operator=(const CameraRenderer&) = delete;
 
+  // With motion blur or rolling shutter on, motion says how the camera moves
+  // about T_world_cam (none: it stands still); the depth is the frame time's.
   RenderedImage render(const Eigen::Isometry3d& T_world_cam, std::int64_t utime,
-                       bool with_depth = false);
+                       bool with_depth = false, const CameraMotion& motion = {});
 
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
   const CameraParams& params() const { return params_; }
@@ -53,6 +63,10 @@ class CameraRenderer {
   std::unique_ptr<Target> scene_;
   std::unique_ptr<Target> output_;
   unsigned int post_program_ = 0;
+  unsigned int motion_program_ = 0;
+  unsigned int motion_indices_ = 0;
+  int motion_cells_x_ = 0;
+  int motion_index_count_ = 0;
   unsigned int post_vertex_array_ = 0;
   unsigned int distortion_map_ = 0;
   // Scene pixel coordinates of each output pixel (for depth with distortion).

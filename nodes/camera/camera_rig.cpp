@@ -1,6 +1,8 @@
 #include "nodes/camera/camera_rig.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <stdexcept>
 
@@ -43,26 +45,79 @@ CameraRig::CameraRig(render::TerrainRenderer& terrain,
     core::validateParams([&spec](core::ParamVisitor& v) { spec.visit(v); }, "cameras." + name);
     Camera camera;
     camera.renderer = std::make_unique<render::CameraRenderer>(terrain, spec.camera);
+    camera.half_span_us = core::utimeFromSeconds(spec.camera.motionHalfSpan_s());
+    if (camera.half_span_us > 0)
+      history_span_us_ = std::max(history_span_us_, 2 * camera.half_span_us + 200000);
     cameras_.emplace(name, std::move(camera));
   }
 }
 
 void CameraRig::reset() {
-  for (auto& [name, camera] : cameras_) camera.next_due_utime = core::kDueAtFirstCall;
+  for (auto& [name, camera] : cameras_) {
+    camera.next_due_utime = core::kDueAtFirstCall;
+    camera.waiting.clear();
+  }
+  history_.clear();
   last_utime_ = -1;
+}
+
+Eigen::Isometry3d CameraRig::poseAt(std::int64_t utime) const {
+  if (utime <= history_.front().utime) return history_.front().T_world_body;
+  if (utime >= history_.back().utime) return history_.back().T_world_body;
+  const auto after =
+      std::lower_bound(history_.begin(), history_.end(), utime,
+                       [](const StampedPose& pose, std::int64_t t) { return pose.utime < t; });
+  const auto before = std::prev(after);
+  const double f = static_cast<double>(utime - before->utime) /
+                   static_cast<double>(after->utime - before->utime);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(before->T_world_body.rotation())
+                   .slerp(f, Eigen::Quaterniond(after->T_world_body.rotation()))
+                   .toRotationMatrix();
+  T.translation() =
+      (1.0 - f) * before->T_world_body.translation() + f * after->T_world_body.translation();
+  return T;
+}
+
+render::CameraMotion CameraRig::motionAt(std::int64_t utime, std::int64_t half_span_us,
+                                         const Eigen::Isometry3d& T_body_cam) const {
+  const std::int64_t t_a = std::max(utime - half_span_us, history_.front().utime);
+  const std::int64_t t_b = std::min(utime + half_span_us, history_.back().utime);
+  render::CameraMotion motion;
+  if (t_b <= t_a) return motion;
+  const double dt_s = static_cast<double>(t_b - t_a) * 1e-6;
+  const Eigen::Isometry3d T_cam_a = poseAt(t_a) * T_body_cam;
+  const Eigen::Isometry3d T_cam_b = poseAt(t_b) * T_body_cam;
+  const Eigen::Isometry3d T_cam = poseAt(utime) * T_body_cam;
+  const Eigen::AngleAxisd turn(T_cam_a.rotation().transpose() * T_cam_b.rotation());
+  motion.omega_cam_rps = turn.axis() * (turn.angle() / dt_s);
+  motion.v_cam_mps =
+      T_cam.rotation().transpose() * (T_cam_b.translation() - T_cam_a.translation()) / dt_s;
+  return motion;
 }
 
 std::vector<CameraFrame> CameraRig::onPose(std::int64_t utime,
                                            const Eigen::Isometry3d& T_world_body) {
   if (utime < last_utime_) reset();
   last_utime_ = utime;
+  history_.push_back({utime, T_world_body});
+  while (history_.size() > 2 && history_[1].utime <= utime - history_span_us_) history_.pop_front();
   std::vector<CameraFrame> frames;
   for (auto& [name, camera] : cameras_) {
     const CameraSpec& spec = specs_.at(name);
     // Due times sit on a fixed grid, so a late pose does not shift later frames.
-    if (!core::due(utime, spec.fps, camera.next_due_utime)) continue;
-    frames.push_back(
-        {name, &spec, camera.renderer->render(T_world_body * spec.T_body_cam(), utime)});
+    if (core::due(utime, spec.fps, camera.next_due_utime)) camera.waiting.push_back(utime);
+    while (!camera.waiting.empty() && camera.waiting.front() + camera.half_span_us <= utime) {
+      const std::int64_t frame_utime = camera.waiting.front();
+      camera.waiting.pop_front();
+      const Eigen::Isometry3d T_body_cam = spec.T_body_cam();
+      const render::CameraMotion motion =
+          camera.half_span_us > 0 ? motionAt(frame_utime, camera.half_span_us, T_body_cam)
+                                  : render::CameraMotion{};
+      frames.push_back(
+          {name, &spec,
+           camera.renderer->render(poseAt(frame_utime) * T_body_cam, frame_utime, false, motion)});
+    }
   }
   return frames;
 }

@@ -4,6 +4,7 @@
 // pose. No LCM here: main.cpp feeds poses in and sends the frames out.
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -47,9 +48,12 @@ class CameraRig {
   // Needs a current GL context for its whole life.
   CameraRig(render::TerrainRenderer& terrain, const std::map<std::string, CameraSpec>& cameras);
 
-  // A true pose of the body at utime (message time). Returns the frames that
-  // fell due: a camera at f frames/s renders at the first pose at or after each
-  // multiple of 1/f s, stamped with that pose's utime.
+  // A true pose of the body at utime (message time), in time order. Returns
+  // the frames that fell due: a camera at f frames/s renders at the first pose
+  // at or after each multiple of 1/f s, stamped with that pose's utime. With
+  // motion blur or rolling shutter on, a frame waits for the poses that cover
+  // its exposure (the render's motionHalfSpan_s after it) and moves with the
+  // camera's velocity between the poses that half-span before and after it.
   std::vector<CameraFrame> onPose(std::int64_t utime, const Eigen::Isometry3d& T_world_body);
 
   // Forget frame timing (after a jump back in time, e.g. a log restarted).
@@ -62,9 +66,22 @@ class CameraRig {
   struct Camera {
     std::unique_ptr<render::CameraRenderer> renderer;
     std::int64_t next_due_utime = core::kDueAtFirstCall;
+    std::int64_t half_span_us = 0;
+    std::deque<std::int64_t> waiting;  // due frames' utimes, waiting for later poses
   };
+  struct StampedPose {
+    std::int64_t utime;
+    Eigen::Isometry3d T_world_body;
+  };
+  // The body pose at utime, interpolated in the history (clamped to its ends).
+  Eigen::Isometry3d poseAt(std::int64_t utime) const;
+  render::CameraMotion motionAt(std::int64_t utime, std::int64_t half_span_us,
+                                const Eigen::Isometry3d& T_body_cam) const;
+
   std::map<std::string, CameraSpec> specs_;
   std::map<std::string, Camera> cameras_;
+  std::deque<StampedPose> history_;
+  std::int64_t history_span_us_ = 0;
   std::int64_t last_utime_ = -1;
 };
 

@@ -235,5 +235,113 @@ TEST(CameraRenderer, TileCacheRespectsItsBudget) {
   EXPECT_GT(most, 8u * 1024 * 1024) << "the flight should have filled the cache";
 }
 
+// ---------------------------------------------------------------- motion
+
+// The thesis's camera (1280x960, 84.872 deg: f = 700 px) 5 m over the board,
+// level, nose north: the board's east edges are vertical lines in the image.
+CameraParams thesisCamera() {
+  CameraParams params;
+  params.width = 1280;
+  params.height = 960;
+  params.hfov_deg = 84.872;
+  params.ground_detail = false;
+  return params;
+}
+
+// Rolling right at 45 deg/s about the nose, in the camera's optical frame.
+CameraMotion rollingRight() {
+  CameraMotion motion;
+  motion.omega_cam_rps =
+      core::rotationBodyFromDownCamera().transpose() * Eigen::Vector3d(45.0 * kDeg, 0.0, 0.0);
+  return motion;
+}
+
+// Sub-pixel position (centroid of |d/dx|) and variance of the line-spread
+// function of the edge near x0 along rows [row0, row1).
+struct EdgeProfile {
+  double x = 0.0;
+  double variance = 0.0;
+};
+EdgeProfile edgeAt(const cv::Mat& image, double x0, int row0, int row1) {
+  constexpr int kHalf = 14;
+  std::vector<double> weight(2 * kHalf, 0.0);
+  const int start = static_cast<int>(std::lround(x0)) - kHalf;
+  for (int row = row0; row < row1; ++row) {
+    for (int i = 0; i < 2 * kHalf; ++i) {
+      weight[i] += std::abs(static_cast<double>(image.at<std::uint8_t>(row, start + i + 1)) -
+                            image.at<std::uint8_t>(row, start + i));
+    }
+  }
+  double sum = 0.0, first = 0.0, second = 0.0;
+  for (int i = 0; i < 2 * kHalf; ++i) {
+    const double x = start + i + 0.5;
+    sum += weight[i];
+    first += weight[i] * x;
+    second += weight[i] * x * x;
+  }
+  EdgeProfile edge;
+  edge.x = first / sum;
+  edge.variance = second / sum - edge.x * edge.x;
+  return edge;
+}
+
+// A 5 ms exposure in a 45 deg/s roll smears the image by f tan(0.225 deg) =
+// 2.75 px at the centre (f (tan(a + 0.225 deg) - tan a) at angle a off the
+// axis). A box blur of width w adds w^2 / 12 to the edge's line-spread variance,
+// and the bilinear lookups at the moving positions (fractions spread evenly
+// over a pixel) add the mean of f (1 - f), 1/6 px^2.
+TEST(CameraRenderer, MotionBlurSmearsByTheRotationDuringTheExposure) {
+  Fixture fixture;
+  CameraParams params = thesisCamera();
+  params.motion_blur = true;
+  params.exposure_s = 0.005;
+  params.motion_blur_samples = 16;
+  CameraRenderer camera(*fixture.terrain, params);
+  const Eigen::Isometry3d T_world_cam = downCameraPose({0.0, 0.0, -5.0}, 0.0, 0.0, 0.0);
+  const cv::Mat sharp = camera.render(T_world_cam, 0).image.clone();
+  const cv::Mat blurred = camera.render(T_world_cam, 0, false, rollingRight()).image.clone();
+  const CameraIntrinsics& k = camera.intrinsics();
+  const double x_edge = k.cx + k.fx * fixture.world->cornerEast_m(3) / 5.0;
+  const EdgeProfile before = edgeAt(sharp, x_edge, 470, 490);
+  const EdgeProfile after = edgeAt(blurred, x_edge, 470, 490);
+  const double a = std::atan((x_edge - k.cx) / k.fx);
+  const double expected_px = k.fx * (std::tan(a + 0.225 * kDeg) - std::tan(a));
+  EXPECT_NEAR(k.fx * std::tan(0.225 * kDeg), 2.75, 0.01);
+  EXPECT_NEAR(std::sqrt(12.0 * (after.variance - before.variance - 1.0 / 6.0)), expected_px, 0.15);
+  // The exposure is centred on the frame's time: the edge stays where it was.
+  EXPECT_NEAR(after.x, before.x, 0.1);
+  const cv::Mat again = camera.render(T_world_cam, 0, false, rollingRight()).image;
+  EXPECT_EQ(cv::norm(blurred, again, cv::NORM_INF), 0.0) << "the same motion, other bytes";
+}
+
+// A 30 ms readout in a 45 deg/s roll: row r is exposed 30 ms (r / 959 - 1/2)
+// after the frame's time, so an edge that is vertical with a global shutter
+// leans by f (tan(a + w dt) - tan a) between two rows dt apart (16.5 px top to
+// bottom at the centre column), the middle row where it was.
+TEST(CameraRenderer, RollingShutterShiftsRowsByTheRotationDuringTheReadout) {
+  Fixture fixture;
+  CameraParams params = thesisCamera();
+  params.rolling_shutter = true;
+  params.readout_s = 0.03;
+  CameraRenderer camera(*fixture.terrain, params);
+  const Eigen::Isometry3d T_world_cam = downCameraPose({0.0, 0.0, -5.0}, 0.0, 0.0, 0.0);
+  const cv::Mat still = camera.render(T_world_cam, 0).image.clone();
+  const cv::Mat rolling = camera.render(T_world_cam, 0, false, rollingRight()).image.clone();
+  const CameraIntrinsics& k = camera.intrinsics();
+  EXPECT_NEAR(k.fx * std::tan(45.0 * kDeg * 0.03), 16.5, 0.05);
+  const double x_edge = k.cx + k.fx * fixture.world->cornerEast_m(3) / 5.0;
+  const double a = std::atan((x_edge - k.cx) / k.fx);
+  const int top = 40, bottom = 920, band = 4;
+  const double dt_s = 0.03 * (bottom - top) / 959.0;
+  const double expected_px = k.fx * (std::tan(a + 45.0 * kDeg * dt_s) - std::tan(a));
+  const double still_top = edgeAt(still, x_edge, top, top + band).x;
+  const double still_bottom = edgeAt(still, x_edge, bottom, bottom + band).x;
+  EXPECT_NEAR(still_top, still_bottom, 0.1) << "the edge should be vertical without motion";
+  const double lean =
+      edgeAt(rolling, x_edge, bottom, bottom + band).x - edgeAt(rolling, x_edge, top, top + band).x;
+  EXPECT_NEAR(std::abs(lean), expected_px, 0.3);
+  EXPECT_NEAR(edgeAt(rolling, x_edge, 478, 482).x, edgeAt(still, x_edge, 478, 482).x, 0.15);
+}
+
 }  // namespace
 }  // namespace nadir::render
