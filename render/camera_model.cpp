@@ -96,6 +96,22 @@ void CameraParams::visit(core::ParamVisitor& v) {
           {.doc = "expose the rows one after the other over readout_s"});
   v.field("readout_s", &readout_s,
           {.doc = "time from the first row to the last, s", .min = 0, .max = 1});
+  v.field("vignetting", &vignetting, {.doc = "darken towards the corners as a lens does"});
+  v.field("vignetting_corner", &vignetting_corner,
+          {.doc = "share of the centre's light at the image corner", .min = 0.01, .max = 1});
+  v.field("response_curve", &response_curve, {.doc = "apply a gamma response after the noise"});
+  v.field("response_gamma", &response_gamma,
+          {.doc = "counts = 255 (linear / 255)^(1 / gamma)", .min = 0.1, .max = 10});
+  v.field("auto_exposure", &auto_exposure,
+          {.doc = "steer a gain so that the frames' mean reaches ae_target_counts"});
+  v.field("ae_target_counts", &ae_target_counts,
+          {.doc = "mean the auto-exposure aims at, counts", .min = 1, .max = 254});
+  v.field("ae_time_constant_s", &ae_time_constant_s,
+          {.doc = "auto-exposure time constant, s", .min = 0.001, .max = 100});
+  v.field("ae_gain_min", &ae_gain_min,
+          {.doc = "least auto-exposure gain", .min = 1e-4, .max = 1e4});
+  v.field("ae_gain_max", &ae_gain_max,
+          {.doc = "largest auto-exposure gain", .min = 1e-4, .max = 1e4});
   v.field("motion_margin_px", &motion_margin_px,
           {.doc = "scene drawn this much wider per side for blur and rolling shutter, px",
            .min = 0,

@@ -79,6 +79,22 @@ struct CameraParams {
   // With either on, the scene is drawn this much wider on each side, so that
   // what moves into the frame during the exposure or readout is there, px.
   int motion_margin_px = 48;
+  // Vignetting: the lens passes vignetting_corner of the centre's light at the
+  // image corner, falling off as 1 / (1 + k r^2)^2 (r: distance from the
+  // principal point over the focal length; cos^4 for k = 1).
+  bool vignetting = false;
+  double vignetting_corner = 0.5;
+  // Response: counts = 255 (linear / 255)^(1 / response_gamma), after the noise.
+  bool response_curve = false;
+  double response_gamma = 2.2;
+  // Auto-exposure: a gain (on top of gain) that brings the mean of the frames
+  // to ae_target_counts, with a first-order lag of ae_time_constant_s in its
+  // logarithm, from the frame before.
+  bool auto_exposure = false;
+  double ae_target_counts = 100.0;
+  double ae_time_constant_s = 0.3;
+  double ae_gain_min = 0.05;
+  double ae_gain_max = 16.0;
 
   void visit(core::ParamVisitor& v);
   CameraIntrinsics intrinsics() const;

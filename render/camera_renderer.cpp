@@ -29,6 +29,10 @@ uniform float u_read_noise;
 uniform float u_electrons_per_count;
 uniform uvec2 u_seed;
 uniform bool u_gray;
+uniform float u_exposure_gain;
+uniform float u_vignetting_k;
+uniform vec4 u_lens_k;
+uniform float u_response_gamma;
 out vec4 out_colour;
 
 uint mix32(uint h) {
@@ -49,10 +53,17 @@ float expose(float value01, uvec2 pixel, uint channel) {
   float variance = u_read_noise * u_read_noise;
   if (u_electrons_per_count > 0.0) variance += counts / u_electrons_per_count;
   if (variance > 0.0) counts += sqrt(variance) * gaussian(pixel, channel);
+  if (u_response_gamma != 1.0)
+    counts = 255.0 * pow(clamp(counts, 0.0, 255.0) / 255.0, 1.0 / u_response_gamma);
   return clamp(floor(counts + 0.5), 0.0, 255.0) / 255.0;
 }
 void writeExposed(vec4 colour) {
   uvec2 p = uvec2(ivec2(gl_FragCoord.xy));
+  if (u_vignetting_k > 0.0 || u_exposure_gain != 1.0) {
+    vec2 xy = (gl_FragCoord.xy - 0.5 - u_lens_k.zw) / u_lens_k.xy;
+    float v = 1.0 + u_vignetting_k * dot(xy, xy);
+    colour *= u_exposure_gain / (v * v);
+  }
   if (u_gray) {
     out_colour = vec4(expose(colour.r, p, 0u), 0.0, 0.0, 1.0);
   } else {
@@ -242,7 +253,8 @@ void CameraRenderer::createTargets() {
   const bool noise =
       params_.read_noise_counts > 0.0 || params_.shot_noise_electrons_per_count > 0.0;
   const bool distort = intrinsics_.hasDistortion();
-  post_pass_ = noise || distort || params_.modelsMotion();
+  post_pass_ = noise || distort || params_.modelsMotion() || params_.vignetting ||
+               params_.response_curve || params_.auto_exposure;
   scene_intrinsics_ = intrinsics_;
   scene_intrinsics_.distortion = {};
   if (distort) {
@@ -367,6 +379,29 @@ void CameraRenderer::createTargets() {
   checkGl("creating the camera's framebuffers");
 }
 
+double CameraRenderer::vignettingK() const {
+  if (!params_.vignetting || params_.vignetting_corner >= 1.0) return 0.0;
+  // V(corner) = vignetting_corner at the corner farthest from the principal point.
+  const double x =
+      std::max(intrinsics_.cx, intrinsics_.width - 1 - intrinsics_.cx) / intrinsics_.fx;
+  const double y =
+      std::max(intrinsics_.cy, intrinsics_.height - 1 - intrinsics_.cy) / intrinsics_.fy;
+  return (1.0 / std::sqrt(params_.vignetting_corner) - 1.0) / (x * x + y * y);
+}
+
+double CameraRenderer::exposureGain(std::int64_t utime) {
+  if (!params_.auto_exposure) return 1.0;
+  if (ae_last_utime_ >= 0 && utime > ae_last_utime_) {
+    // log g moves towards log(target / mean) by 1 - e^(-dt / tau) a frame.
+    const double dt_s = static_cast<double>(utime - ae_last_utime_) * 1e-6;
+    const double step = 1.0 - std::exp(-dt_s / params_.ae_time_constant_s);
+    const double error = std::log(params_.ae_target_counts / std::max(ae_last_mean_counts_, 0.5));
+    ae_gain_ =
+        std::clamp(ae_gain_ * std::exp(step * error), params_.ae_gain_min, params_.ae_gain_max);
+  }
+  return ae_gain_;
+}
+
 RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::int64_t utime,
                                      bool with_depth, const CameraMotion& motion) {
   const bool gray = params_.pixel_format == "gray8";
@@ -427,6 +462,13 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
     const auto frame = static_cast<std::uint64_t>(utime);
     glUniform2ui(at("u_seed"), static_cast<GLuint>(seed ^ (seed >> 32) ^ frame),
                  static_cast<GLuint>((frame >> 32) ^ (frame * 0x9E3779B9u)));
+    glUniform1f(at("u_exposure_gain"), static_cast<float>(exposureGain(utime)));
+    glUniform1f(at("u_vignetting_k"), static_cast<float>(vignettingK()));
+    glUniform4f(at("u_lens_k"), static_cast<float>(intrinsics_.fx),
+                static_cast<float>(intrinsics_.fy), static_cast<float>(intrinsics_.cx),
+                static_cast<float>(intrinsics_.cy));
+    glUniform1f(at("u_response_gamma"),
+                params_.response_curve ? static_cast<float>(params_.response_gamma) : 1.f);
     glBindVertexArray(post_vertex_array_);
     if (moving) {
       const Eigen::Vector3f omega = motion.omega_cam_rps.cast<float>();
@@ -469,6 +511,11 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
                GL_UNSIGNED_BYTE, out.image.data);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   checkGl("rendering a camera image");
+  if (params_.auto_exposure) {
+    const cv::Scalar mean = cv::mean(out.image);
+    ae_last_mean_counts_ = gray ? mean[0] : (mean[0] + mean[1] + mean[2]) / 3.0;
+    ae_last_utime_ = utime;
+  }
 
   if (with_depth) {
     if (intrinsics_.hasDistortion()) {

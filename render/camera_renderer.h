@@ -1,7 +1,7 @@
 #pragma once
 // A virtual camera: renders the terrain from a pose into an offscreen
-// framebuffer, applies motion blur, rolling shutter, lens distortion and
-// sensor noise, and reads the image
+// framebuffer, applies motion blur, rolling shutter, lens distortion,
+// vignetting, auto-exposure, sensor noise and a response curve, and reads the image
 // (and optionally per-pixel depth) back. Deterministic: the same pose, utime
 // and parameters give bit-identical images.
 
@@ -49,10 +49,15 @@ class CameraRenderer {
 
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
   const CameraParams& params() const { return params_; }
+  // The auto-exposure's gain for the last frame (1 without auto-exposure).
+  double exposureGain() const { return ae_gain_; }
 
  private:
   struct Target;
   void createTargets();
+  double vignettingK() const;
+  // The auto-exposure's gain for a frame at utime, from the frame before.
+  double exposureGain(std::int64_t utime);
 
   TerrainRenderer& terrain_;
   CameraParams params_;
@@ -71,6 +76,9 @@ class CameraRenderer {
   unsigned int distortion_map_ = 0;
   // Scene pixel coordinates of each output pixel (for depth with distortion).
   cv::Mat map_x_, map_y_;
+  double ae_gain_ = 1.0;
+  double ae_last_mean_counts_ = 0.0;
+  std::int64_t ae_last_utime_ = -1;
 };
 
 }  // namespace nadir::render

@@ -343,5 +343,65 @@ TEST(CameraRenderer, RollingShutterShiftsRowsByTheRotationDuringTheReadout) {
   EXPECT_NEAR(edgeAt(rolling, x_edge, 478, 482).x, edgeAt(still, x_edge, 478, 482).x, 0.15);
 }
 
+// ---------------------------------------------------------------- exposure
+
+// Over the world's uniform gray (128 counts), away from the board.
+const Eigen::Isometry3d kOverGray = downCameraPose({100.0, 100.0, -5.0}, 0.0, 0.0, 0.0);
+
+// Vignetting falls as 1 / (1 + k r^2)^2 with k set so that the corner keeps
+// vignetting_corner of the light: k = (1 / sqrt(0.5) - 1) / r_corner^2.
+TEST(CameraRenderer, VignettingDarkensTowardsTheCornersAsWorkedOut) {
+  Fixture fixture;
+  CameraParams params = testCamera();
+  params.vignetting = true;
+  params.vignetting_corner = 0.5;
+  CameraRenderer camera(*fixture.terrain, params);
+  const cv::Mat image = camera.render(kOverGray, 0).image;
+  const CameraIntrinsics& k = camera.intrinsics();
+  const auto r2 = [&](double u, double v) {
+    return std::pow((u - k.cx) / k.fx, 2) + std::pow((v - k.cy) / k.fy, 2);
+  };
+  const double kk = (1.0 / std::sqrt(0.5) - 1.0) / r2(0.0, 0.0);
+  for (const auto& [u, v] :
+       std::vector<std::pair<int, int>>{{320, 240}, {0, 0}, {160, 120}, {639, 479}, {600, 100}}) {
+    const double expected = 128.0 / std::pow(1.0 + kk * r2(u, v), 2);
+    EXPECT_NEAR(image.at<std::uint8_t>(v, u), expected, 1.0) << "pixel " << u << ", " << v;
+  }
+  EXPECT_NEAR(image.at<std::uint8_t>(0, 0), 64.0, 1.0);
+}
+
+// A gamma response: 255 (128 / 255)^(1 / 2.2) = 186.4 counts.
+TEST(CameraRenderer, ResponseCurveMapsCountsThroughTheGamma) {
+  Fixture fixture;
+  CameraParams params = testCamera();
+  params.response_curve = true;
+  params.response_gamma = 2.2;
+  CameraRenderer camera(*fixture.terrain, params);
+  const cv::Mat image = camera.render(kOverGray, 0).image;
+  EXPECT_NEAR(cv::mean(image)[0], 186.4, 0.6);
+}
+
+// Auto-exposure towards 64 counts over a 128-count scene at 31 frames/s, tau
+// 0.3 s: each frame moves log g by a = 1 - e^(-dt / tau) of the way, so frame
+// n reads 128 (64 / 128)^(1 - (1 - a)^n).
+TEST(CameraRenderer, AutoExposureSettlesWithItsTimeConstant) {
+  Fixture fixture;
+  CameraParams params = testCamera();
+  params.auto_exposure = true;
+  params.ae_target_counts = 64.0;
+  params.ae_time_constant_s = 0.3;
+  CameraRenderer camera(*fixture.terrain, params);
+  constexpr std::int64_t kFrameUs = 32258;
+  const double a = 1.0 - std::exp(-kFrameUs * 1e-6 / 0.3);
+  for (int n = 0; n <= 40; ++n) {
+    const double mean = cv::mean(camera.render(kOverGray, n * kFrameUs).image)[0];
+    const double expected = 128.0 * std::pow(0.5, 1.0 - std::pow(1.0 - a, n));
+    if (n == 0 || n == 1 || n == 5 || n == 10 || n == 40) {
+      EXPECT_NEAR(mean, expected, 1.0) << "frame " << n;
+    }
+  }
+  EXPECT_NEAR(camera.exposureGain(), 0.5, 0.01);
+}
+
 }  // namespace
 }  // namespace nadir::render
