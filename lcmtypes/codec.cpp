@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <type_traits>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -13,6 +15,7 @@
 #include "nadir/baro_t.hpp"
 #include "nadir/body_rates_t.hpp"
 #include "nadir/camera_info_t.hpp"
+#include "nadir/camera_info_v1_t.hpp"
 #include "nadir/geodetic_position_t.hpp"
 #include "nadir/gps_t.hpp"
 #include "nadir/heartbeat_t.hpp"
@@ -419,6 +422,10 @@ Bytes encode(const CameraInfo& message) {
   out.fps = message.fps;
   put3(message.p_cam_in_body_m, out.position_cam_in_body_m);
   core::quaternionToWire(message.q_body_cam, out.orientation_body_cam);
+  out.time_offset_s = message.time_offset_s;
+  out.timestamp_jitter_s = message.timestamp_jitter_s;
+  out.exposure_s = message.exposure_s;
+  out.readout_s = message.readout_s;
   return toBytes(out);
 }
 
@@ -621,9 +628,11 @@ BodyRates decode<BodyRates>(const void* data, std::size_t size) {
   return {in.utime, get3(in.angular_velocity_dps)};
 }
 
-template <>
-CameraInfo decode<CameraInfo>(const void* data, std::size_t size) {
-  const auto in = fromBytes<nadir::camera_info_t>(data, size);
+namespace {
+
+// The fields both layouts of camera_info_t share.
+template <class Lcm>
+CameraInfo cameraInfoFromLcm(const Lcm& in) {
   const std::string at = where(in);
   if (in.width <= 0 || in.height <= 0) {
     throw InvalidMessage(at + ": " + std::to_string(in.width) + "x" + std::to_string(in.height) +
@@ -651,6 +660,31 @@ CameraInfo decode<CameraInfo>(const void* data, std::size_t size) {
   out.fps = in.fps;
   out.p_cam_in_body_m = get3(in.position_cam_in_body_m);
   out.q_body_cam = rotationFromWire(in.orientation_body_cam, "orientation_body_cam", at);
+  return out;
+}
+
+}  // namespace
+
+template <>
+CameraInfo decode<CameraInfo>(const void* data, std::size_t size) {
+  // Logs recorded before the timing fields hold the first layout.
+  if (fingerprintOf(data, size) == nadir::camera_info_v1_t::getHash())
+    return cameraInfoFromLcm(fromBytes<nadir::camera_info_v1_t>(data, size));
+  const auto in = fromBytes<nadir::camera_info_t>(data, size);
+  CameraInfo out = cameraInfoFromLcm(in);
+  const std::string at = where(in);
+  for (const auto& [name, value] :
+       {std::pair{"time_offset_s", in.time_offset_s},
+        std::pair{"timestamp_jitter_s", in.timestamp_jitter_s},
+        std::pair{"exposure_s", in.exposure_s}, std::pair{"readout_s", in.readout_s}}) {
+    requireFinite(value, name, at);
+  }
+  if (in.timestamp_jitter_s < 0 || in.exposure_s < 0 || in.readout_s < 0)
+    throw InvalidMessage(at + ": a negative jitter, exposure or readout time");
+  out.time_offset_s = in.time_offset_s;
+  out.timestamp_jitter_s = in.timestamp_jitter_s;
+  out.exposure_s = in.exposure_s;
+  out.readout_s = in.readout_s;
   return out;
 }
 
@@ -744,6 +778,9 @@ Heartbeat decode<Heartbeat>(const void* data, std::size_t size) {
 
 template <class T>
 bool isType(const void* data, std::size_t size) {
+  if constexpr (std::is_same_v<T, CameraInfo>) {
+    if (fingerprintOf(data, size) == nadir::camera_info_v1_t::getHash()) return true;
+  }
   return fingerprintOf(data, size) == LcmOf<T>::type::getHash();
 }
 
@@ -778,9 +815,10 @@ std::string typeName(const void* data, std::size_t size) {
   static const std::vector<KnownType> kTypes =
       knownTypes<nadir::pose_t, nadir::imu_t, nadir::range_t, nadir::gps_t, nadir::baro_t,
                  nadir::magnetometer_t, nadir::geodetic_position_t, nadir::attitude_t,
-                 nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t, nadir::image_t,
-                 nadir::vo_estimate_t, nadir::ppa_odometry_t, nadir::target_detection_t,
-                 nadir::vo_command_t, nadir::heartbeat_t>();
+                 nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t,
+                 nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t,
+                 nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
+                 nadir::heartbeat_t>();
   const std::int64_t hash = fingerprintOf(data, size);
   for (const KnownType& type : kTypes) {
     if (type.hash == hash) return type.name;

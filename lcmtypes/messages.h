@@ -130,6 +130,11 @@ struct CameraInfo {
   double fps = 0.0;
   Eigen::Vector3d p_cam_in_body_m = Eigen::Vector3d::Zero();
   Eigen::Quaterniond q_body_cam = Eigen::Quaterniond::Identity();
+  // Timing (camera_info_t says how): all zero for an exact, global, instant shutter.
+  double time_offset_s = 0.0;
+  double timestamp_jitter_s = 0.0;
+  double exposure_s = 0.0;
+  double readout_s = 0.0;
 
   Eigen::Isometry3d T_body_cam() const;
   // True when any distortion coefficient is not zero.

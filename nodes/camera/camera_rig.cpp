@@ -25,6 +25,30 @@ void CameraSpec::visit(core::ParamVisitor& v) {
            .list_size = 3});
   v.field("jpeg_quality", &jpeg_quality,
           {.doc = "0 sends raw pixels, 1-100 JPEG of that quality", .min = 0, .max = 100});
+  v.field("time_offset_s", &time_offset_s,
+          {.doc = "stamp minus the true time of each frame, s", .min = -1, .max = 1});
+  v.field("timestamp_jitter_s", &timestamp_jitter_s,
+          {.doc = "Gaussian jitter of the stamps, 1 sigma, s", .min = 0, .max = 0.1});
+  v.field("jitter_seed", &jitter_seed, {.doc = "seed of the stamps' jitter"});
+}
+
+std::int64_t CameraSpec::stampOf(std::int64_t true_utime) const {
+  double jitter_s = 0.0;
+  if (timestamp_jitter_s > 0.0) {
+    // Box-Muller on two draws of splitmix64 from the seed and the frame's time.
+    std::uint64_t state = static_cast<std::uint64_t>(jitter_seed) * 0x9E3779B97F4A7C15ull ^
+                          static_cast<std::uint64_t>(true_utime);
+    const auto next = [&state] {
+      std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      return (static_cast<double>((z ^ (z >> 31)) >> 11) + 0.5) / 9007199254740992.0;
+    };
+    const double u1 = next(), u2 = next();
+    const double gaussian = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+    jitter_s = timestamp_jitter_s * std::clamp(gaussian, -3.0, 3.0);
+  }
+  return true_utime + std::llround((time_offset_s + jitter_s) * 1e6);
 }
 
 Eigen::Isometry3d CameraSpec::T_body_cam() const {
@@ -114,9 +138,10 @@ std::vector<CameraFrame> CameraRig::onPose(std::int64_t utime,
       const render::CameraMotion motion =
           camera.half_span_us > 0 ? motionAt(frame_utime, camera.half_span_us, T_body_cam)
                                   : render::CameraMotion{};
-      frames.push_back(
-          {name, &spec,
-           camera.renderer->render(poseAt(frame_utime) * T_body_cam, frame_utime, false, motion)});
+      render::RenderedImage rendered =
+          camera.renderer->render(poseAt(frame_utime) * T_body_cam, frame_utime, false, motion);
+      rendered.utime = spec.stampOf(frame_utime);
+      frames.push_back({name, &spec, std::move(rendered)});
     }
   }
   return frames;
@@ -144,6 +169,10 @@ msg::CameraInfo cameraInfo(const std::string& name, const CameraSpec& spec,
   const Eigen::Isometry3d T_body_cam = spec.T_body_cam();
   info.p_cam_in_body_m = T_body_cam.translation();
   info.q_body_cam = Eigen::Quaterniond(T_body_cam.rotation());
+  info.time_offset_s = spec.time_offset_s;
+  info.timestamp_jitter_s = spec.timestamp_jitter_s;
+  info.exposure_s = spec.camera.motion_blur ? spec.camera.exposure_s : 0.0;
+  info.readout_s = spec.camera.rolling_shutter ? spec.camera.readout_s : 0.0;
   return info;
 }
 

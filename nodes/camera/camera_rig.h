@@ -32,9 +32,17 @@ struct CameraSpec {
   std::vector<double> mount_rpy_deg = {0.0, 0.0, 0.0};
   // 0 sends raw pixels; 1-100 sends JPEG of that quality (for thin links).
   int jpeg_quality = 0;
+  // Each frame's stamp is its true time plus time_offset_s (the camera's clock
+  // against the body's) plus Gaussian jitter of timestamp_jitter_s (1 sigma,
+  // cut at 3 sigma, from jitter_seed and the frame's time), s.
+  double time_offset_s = 0.0;
+  double timestamp_jitter_s = 0.0;
+  std::int64_t jitter_seed = 1;
 
   void visit(core::ParamVisitor& v);
   Eigen::Isometry3d T_body_cam() const;
+  // The stamp of a frame whose true time is true_utime.
+  std::int64_t stampOf(std::int64_t true_utime) const;
 };
 
 struct CameraFrame {
@@ -50,7 +58,8 @@ class CameraRig {
 
   // A true pose of the body at utime (message time), in time order. Returns
   // the frames that fell due: a camera at f frames/s renders at the first pose
-  // at or after each multiple of 1/f s, stamped with that pose's utime. With
+  // at or after each multiple of 1/f s, stamped with that pose's utime (plus
+  // the spec's clock offset and jitter; the pose drawn is the true one). With
   // motion blur or rolling shutter on, a frame waits for the poses that cover
   // its exposure (the render's motionHalfSpan_s after it) and moves with the
   // camera's velocity between the poses that half-span before and after it.

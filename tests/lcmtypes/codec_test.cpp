@@ -18,6 +18,7 @@
 #include "core/frames.h"
 #include "nadir/baro_t.hpp"
 #include "nadir/camera_info_t.hpp"
+#include "nadir/camera_info_v1_t.hpp"
 #include "nadir/gps_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
@@ -303,6 +304,49 @@ TEST(Codec, CameraInfoRoundTripAndRefusals) {
   bad = wire;
   bad.orientation_body_cam[0] = 3.0;
   EXPECT_NE(invalidReason<CameraInfo>(bad).find("orientation_body_cam"), std::string::npos);
+  bad = wire;
+  bad.readout_s = -0.01;
+  EXPECT_NE(invalidReason<CameraInfo>(bad).find("negative"), std::string::npos);
+}
+
+// The timing fields travel; a camera_info_t of the first layout (logs recorded
+// before them) is still a CameraInfo, with an exact, global, instant shutter.
+TEST(Codec, CameraInfoTimingAndTheFirstLayout) {
+  CameraInfo info;
+  info.utime = 7;
+  info.camera_name = "down";
+  info.width = 640;
+  info.height = 480;
+  info.fx = info.fy = 500.0;
+  info.fps = 20.0;
+  info.time_offset_s = 0.004;
+  info.timestamp_jitter_s = 0.0005;
+  info.exposure_s = 0.005;
+  info.readout_s = 0.03;
+  const CameraInfo back = decode<CameraInfo>(encode(info));
+  EXPECT_EQ(back.time_offset_s, 0.004);
+  EXPECT_EQ(back.timestamp_jitter_s, 0.0005);
+  EXPECT_EQ(back.exposure_s, 0.005);
+  EXPECT_EQ(back.readout_s, 0.03);
+
+  nadir::camera_info_v1_t old{};
+  old.utime = 9;
+  old.camera_name = "down";
+  old.width = 640;
+  old.height = 480;
+  old.fx = old.fy = 500.0;
+  old.cx = 319.5;
+  old.cy = 239.5;
+  old.fps = 20.0;
+  old.orientation_body_cam[0] = 1.0;
+  const Bytes bytes = bytesOf(old);
+  EXPECT_TRUE(isType<CameraInfo>(bytes.data(), bytes.size()));
+  const CameraInfo legacy = decode<CameraInfo>(bytes);
+  EXPECT_EQ(legacy.utime, 9);
+  EXPECT_EQ(legacy.cx, 319.5);
+  EXPECT_EQ(legacy.readout_s, 0.0);
+  EXPECT_EQ(legacy.time_offset_s, 0.0);
+  EXPECT_NE(nadir::camera_info_v1_t::getHash(), nadir::camera_info_t::getHash());
 }
 
 // ---------------------------------------------------------------- vo_estimate_t
