@@ -19,6 +19,7 @@
 #include "nodes/scenario.h"
 #include "nodes/sim/sim_node.h"
 #include "nodes/sim/simulator.h"
+#include "render/image_texture.h"
 #include "run/process.h"
 #include "run/track_plot.h"
 #include "terrain/world.h"
@@ -95,11 +96,19 @@ RunResult runScenario(const RunOptions& options,
       running_nodes.begin(), running_nodes.end(),
       [](const auto& node) { return node.first->info().role == nodes::EntryInfo::Role::kCamera; });
   camera::CameraNode camera(*bus, camera_params->second.as<camera::CameraNodeParams>());
-  // The main camera's last image, for a picture of what it saw.
+  // The main camera's last image, for a picture of what it saw, and its
+  // texture from one frame a second of sim time.
   cv::Mat last_image;
-  core::Subscription last_image_keeper = msg::subscribe<msg::Image>(
-      *bus, scenario.camera.channel,
-      [&last_image](const msg::Image& image) { last_image = image.pixels; });
+  render::TextureMeter texture;
+  std::int64_t last_measured_utime = 0;
+  core::Subscription last_image_keeper =
+      msg::subscribe<msg::Image>(*bus, scenario.camera.channel, [&](const msg::Image& image) {
+        last_image = image.pixels;
+        if (texture.result().frames == 0 || image.utime - last_measured_utime >= 1'000'000) {
+          texture.add(image.pixels);
+          last_measured_utime = image.utime;
+        }
+      });
   const core::LocalNedFrame frame(camera.scene().built.origin);
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
@@ -150,6 +159,8 @@ RunResult runScenario(const RunOptions& options,
     cv::imwrite(result.picture_paths.back(), last_image);
   }
   result.table = eval::formatResultsTable(result.metrics);
+  if (texture.result().frames > 0)
+    result.table += "camera " + render::formatTexture(texture.result()) + "\n";
   const nodes::BatchReportInput report_input{scenario, result.log_path, evaluation.recorded,
                                              result.out_dir, *camera.scene().built.world};
   for (const auto& [entry, params] : running_nodes) {
