@@ -41,6 +41,9 @@ struct ProceduralWorldParams {
   double bare_soil_fraction = 0.15;
   double hedge_fraction = 0.2;
   double buildings_per_km2 = 12.0;
+  // Scales the texture inside the fields (crop rows, patchiness, fine detail):
+  // 1 as drawn, 0 uniform fields with only their edges.
+  double texture_strength = 1.0;
 
   void visit(core::ParamVisitor& v) {
     v.field("seed", &seed,
@@ -56,7 +59,7 @@ struct ProceduralWorldParams {
              .min = 0,
              .max = 2000});
     v.field("imagery_resolution_m", &imagery_resolution_m,
-            {.doc = "finest imagery ground sample distance, m/px", .min = 0.25, .max = 0.5});
+            {.doc = "finest imagery ground sample distance, m/px", .min = 0.25, .max = 2});
     v.field("sun_azimuth_deg", &sun_azimuth_deg,
             {.doc = "direction of the sun, deg clockwise from north", .min = 0, .max = 360});
     v.field("sun_elevation_deg", &sun_elevation_deg,
@@ -79,6 +82,8 @@ struct ProceduralWorldParams {
             {.doc = "fraction of field boundaries lined with hedgerow trees", .min = 0, .max = 1});
     v.field("buildings_per_km2", &buildings_per_km2,
             {.doc = "mean number of buildings per square kilometre", .min = 0, .max = 200});
+    v.field("texture_strength", &texture_strength,
+            {.doc = "texture inside the fields: 1 as drawn, 0 uniform fields", .min = 0, .max = 2});
   }
 };
 

@@ -199,6 +199,14 @@ FieldInfo Generator::fieldInfoAt(u64 id, const BlockFrame& f) const {
   fi.crop = chooseCrop(u(0), p.bare_soil_fraction);
   setLayout(fi, f, u);
   setCropLook(fi, u);
+  const double k = p.texture_strength;
+  fi.row_cover *= k;
+  fi.row_bright *= k;
+  fi.band_bright *= k;
+  fi.var_cover *= k;
+  fi.var_bright *= k;
+  fi.detail *= k;
+  fi.fine *= k;
   return fi;
 }
 

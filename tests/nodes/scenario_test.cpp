@@ -82,8 +82,8 @@ std::string writeTemp(const std::string& name, const std::string& text) {
 // The scenarios the issue names are all built in and load with their documented values.
 TEST(Scenario, BuiltInsLoad) {
   const std::vector<std::string> names = builtinScenarioNames();
-  for (const char* name :
-       {"thesis-oscillating", "box", "cloverleaf", "grid", "scamp-rectangle", "default"}) {
+  for (const char* name : {"thesis-oscillating", "thesis-atterbury", "box", "cloverleaf", "grid",
+                           "scamp-rectangle", "default"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
     ScenarioParams scenario;
     ASSERT_NO_THROW(scenario = loadScenario(name)) << name;
@@ -103,6 +103,15 @@ TEST(Scenario, BuiltInsLoad) {
   EXPECT_DOUBLE_EQ(scamp.camera.fps, 200.0);
   ASSERT_EQ(scamp.targets.count("start_corner"), 1u);
   EXPECT_EQ(scamp.targets.at("start_corner").kind, "concentric");
+  // The thesis's conditions: every camera effect on, the estimated attitude, low texture.
+  const ScenarioParams atterbury = loadScenario("thesis-atterbury");
+  const render::CameraParams& camera = atterbury.camera.camera;
+  EXPECT_TRUE(camera.motion_blur && camera.rolling_shutter && camera.vignetting &&
+              camera.auto_exposure && camera.response_curve);
+  EXPECT_GT(camera.read_noise_counts, 0.0);
+  EXPECT_GT(atterbury.camera.timestamp_jitter_s, 0.0);
+  EXPECT_EQ(atterbury.sim.sensors.ahrs.estimator, "complementary");
+  EXPECT_EQ(atterbury.sim.vehicle.altitude_agl_m, 300.0);
 }
 
 // The effective scenario a run writes (scenario.yaml) loads back to the same
