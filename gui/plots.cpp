@@ -65,6 +65,18 @@ QString sourceLabel(const RunData& run, const std::string& name) {
 
 namespace {
 
+// Sets an axis's range, first widening a tick interval that would be far too
+// fine for it: with dynamic ticks Qt lays the old interval out over the new
+// range before anyone can change it, and an interval a million times too small
+// (a diverged estimate's kilometres after metres) hangs it making tick items.
+void setAxisRange(QValueAxis* axis, double lo, double hi) {
+  if (axis->tickType() == QValueAxis::TicksDynamic && hi > lo &&
+      axis->tickInterval() < (hi - lo) / 1000.0) {
+    axis->setTickInterval((hi - lo) / 10.0);
+  }
+  axis->setRange(lo, hi);
+}
+
 // Enough points for a 1200 px wide chart; more only slow the drawing down.
 constexpr std::size_t kMaxPointsPerSeries = 4000;
 // A line is broken where samples are further apart than this (a gap in the
@@ -183,7 +195,7 @@ class ChartBuilder {
 
   static void setRange(QValueAxis* axis, const Range& range, double margin) {
     if (range.empty()) {
-      axis->setRange(0, 1);
+      setAxisRange(axis, 0, 1);
       return;
     }
     double lo = range.min;
@@ -191,7 +203,7 @@ class ChartBuilder {
     const double pad = std::max((hi - lo) * margin, hi == lo ? 1.0 : 0.0);
     lo -= pad;
     hi += pad;
-    axis->setRange(lo, hi);
+    setAxisRange(axis, lo, hi);
   }
 
   std::unique_ptr<QChart> chart_;
@@ -255,8 +267,8 @@ void equalizeAxes(QValueAxis* x_axis, QValueAxis* y_axis, const Range& x, const 
       std::max((x.max - x.min + 2 * pad) / area.width(), (y.max - y.min + 2 * pad) / area.height());
   const double x_mid = 0.5 * (x.min + x.max);
   const double y_mid = 0.5 * (y.min + y.max);
-  x_axis->setRange(x_mid - 0.5 * scale * area.width(), x_mid + 0.5 * scale * area.width());
-  y_axis->setRange(y_mid - 0.5 * scale * area.height(), y_mid + 0.5 * scale * area.height());
+  setAxisRange(x_axis, x_mid - 0.5 * scale * area.width(), x_mid + 0.5 * scale * area.width());
+  setAxisRange(y_axis, y_mid - 0.5 * scale * area.height(), y_mid + 0.5 * scale * area.height());
 }
 
 // Keeps the same metres per pixel on both axes: fitted to the whole track (x, y)
@@ -277,7 +289,7 @@ void keepEqualScale(QChart* chart, QValueAxis* x_axis, QValueAxis* y_axis, const
     const double length_px = x_mpp < y_mpp ? area.width() : area.height();
     const double mid = 0.5 * (widened->min() + widened->max());
     const double half = 0.5 * std::max(x_mpp, y_mpp) * length_px;
-    widened->setRange(mid - half, mid + half);
+    setAxisRange(widened, mid - half, mid + half);
     *adjusting = false;
   };
   equalizeAxes(x_axis, y_axis, x, y, chart->plotArea());
@@ -367,7 +379,7 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
   std::unique_ptr<QChart> built = chart.take();
   // An error axis starts at zero: the error's size, not its wiggle, is the point.
   auto* y_axis = static_cast<QValueAxis*>(built->axes(Qt::Vertical).front());
-  if (!chart.yRange().empty()) y_axis->setRange(0, chart.yRange().max * 1.05);
+  if (!chart.yRange().empty()) setAxisRange(y_axis, 0, chart.yRange().max * 1.05);
   figure.charts.push_back(std::move(built));
   return figure;
 }

@@ -59,6 +59,27 @@ PixelCounts countPixels(const QImage& image, const QColor& source) {
   return counts;
 }
 
+// A diverged estimate (thousands of km off a truth of metres) is drawn like
+// any other: each figure is written, its axes spanning the estimate. (Qt laid a
+// metre-sized tick interval over the widened range and hung making items.)
+TEST_F(GuiPlots, ADivergedEstimateIsDrawn) {
+  const fs::path dir = test::freshDir("plots_diverged");
+  core::writeTum((dir / "truth.tum").string(), test::truthTrajectory());
+  core::Trajectory diverged = test::estimateTrajectory();
+  for (std::size_t j = 0; j < diverged.size(); ++j)
+    diverged[j].p_ned_m += Eigen::Vector3d(4e7, -3e7, 1e6) * static_cast<double>(j) /
+                           static_cast<double>(diverged.size());
+  core::writeTum((dir / "vo_test.tum").string(), diverged);
+  const RunData run = loadRun(dir.string());
+  const fs::path out = test::freshDir("plots_diverged_out");
+  for (Figure& figure : buildFigures(run)) {
+    const std::string name = figure.name;
+    const fs::path path = out / (name + ".png");
+    renderFigurePng(std::move(figure), path.string(), 1200, 800);
+    EXPECT_FALSE(QImage(QString::fromStdString(path.string())).isNull()) << name;
+  }
+}
+
 TEST_F(GuiPlots, HeadlessRenderingWritesNonBlankPngsOfTheRightSize) {
   const RunData run = loadRun(test::writeTumRun("plots_run").string());
   const fs::path out = test::freshDir("plots_out");
