@@ -75,10 +75,9 @@ int main(int argc, char** argv) {
       const nadir::core::RollPitchYaw truth =
           nadir::core::rpyFromQuaternion(out.truth.q_world_body);
       const nadir::msg::Attitude& estimate = out.nav->attitude;
-      const double e_roll =
-          std::remainder(estimate.roll_rad - truth.roll_rad, 2 * std::numbers::pi);
+      const double e_roll = nadir::core::wrapAngle_rad(estimate.roll_rad - truth.roll_rad);
       const double e_pitch = estimate.pitch_rad - truth.pitch_rad;
-      const double e_yaw = std::remainder(estimate.yaw_rad - truth.yaw_rad, 2 * std::numbers::pi);
+      const double e_yaw = nadir::core::wrapAngle_rad(estimate.yaw_rad - truth.yaw_rad);
       const Eigen::Vector3d omega_ned = out.truth.q_world_body * out.truth.omega_body_rps;
       const bool is_turning = std::fabs(omega_ned.z()) * kDeg > 5.0;
       for (AttitudeStats* s : {&all, is_turning ? &turning : &straight}) {

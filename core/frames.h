@@ -11,6 +11,9 @@
 // lowers the right wing, positive pitch raises the nose, positive yaw turns the
 // nose from north towards east. Quaternions are Hamilton, w first on the wire.
 
+#include <cmath>
+#include <numbers>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -30,6 +33,11 @@ Eigen::Quaterniond quaternionFromRpy(const RollPitchYaw& rpy);
 // the whole rotation about the vertical.
 RollPitchYaw rpyFromRotation(const Eigen::Matrix3d& R_world_body);
 RollPitchYaw rpyFromQuaternion(const Eigen::Quaterniond& q_world_body);
+
+// An angle brought into [-pi, pi].
+inline double wrapAngle_rad(double angle_rad) {
+  return std::remainder(angle_rad, 2.0 * std::numbers::pi);
+}
 
 // R_body_cam of a camera looking straight down along body +z with the top of
 // the image towards the nose: camera x = body y, camera y = -body x.

@@ -31,7 +31,7 @@ uniform uvec2 u_seed;
 uniform bool u_gray;
 uniform float u_exposure_gain;
 uniform float u_vignetting_k;
-uniform vec4 u_lens_k;
+uniform vec4 u_output_k;
 uniform float u_response_gamma;
 out vec4 out_colour;
 
@@ -60,7 +60,7 @@ float expose(float value01, uvec2 pixel, uint channel) {
 void writeExposed(vec4 colour) {
   uvec2 p = uvec2(ivec2(gl_FragCoord.xy));
   if (u_vignetting_k > 0.0 || u_exposure_gain != 1.0) {
-    vec2 xy = (gl_FragCoord.xy - 0.5 - u_lens_k.zw) / u_lens_k.xy;
+    vec2 xy = (gl_FragCoord.xy - 0.5 - u_output_k.zw) / u_output_k.xy;
     float v = 1.0 + u_vignetting_k * dot(xy, xy);
     colour *= u_exposure_gain / (v * v);
   }
@@ -257,6 +257,8 @@ void CameraRenderer::createTargets() {
                params_.response_curve || params_.auto_exposure;
   scene_intrinsics_ = intrinsics_;
   scene_intrinsics_.distortion = {};
+  // With motion, room for what moves into the frame during the exposure or readout.
+  const int margin = params_.modelsMotion() ? params_.motion_margin_px : 0;
   if (distort) {
     // Undistorted footprint of the distorted image's border, one pixel of margin.
     double min_x = 1e9, max_x = -1e9, min_y = 1e9, max_y = -1e9;
@@ -286,8 +288,10 @@ void CameraRenderer::createTargets() {
       throw GlContextError(
           "camera distortion widens the view more than 4 times: check the coefficients");
     }
-    scene_intrinsics_.cx = -min_x * intrinsics_.fx + 1.5;
-    scene_intrinsics_.cy = -min_y * intrinsics_.fy + 1.5;
+    scene_intrinsics_.width += 2 * margin;
+    scene_intrinsics_.height += 2 * margin;
+    scene_intrinsics_.cx = -min_x * intrinsics_.fx + 1.5 + margin;
+    scene_intrinsics_.cy = -min_y * intrinsics_.fy + 1.5 + margin;
 
     // For each output pixel, where it looks in the undistorted scene.
     map_x_.create(intrinsics_.height, intrinsics_.width, CV_32FC1);
@@ -313,34 +317,11 @@ void CameraRenderer::createTargets() {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, intrinsics_.width, intrinsics_.height, GL_RG, GL_FLOAT,
                     uv.data);
-  }
-  if (params_.modelsMotion()) {
-    // Room for what moves into the frame; the distortion map is in scene texture
-    // coordinates, so it is made again for the wider scene.
-    const int m = params_.motion_margin_px;
-    scene_intrinsics_.width += 2 * m;
-    scene_intrinsics_.height += 2 * m;
-    scene_intrinsics_.cx += m;
-    scene_intrinsics_.cy += m;
-    if (distort) {
-      cv::Mat uv(intrinsics_.height, intrinsics_.width, CV_32FC2);
-      for (int v = 0; v < intrinsics_.height; ++v) {
-        for (int u = 0; u < intrinsics_.width; ++u) {
-          const bool inside = map_x_.at<float>(v, u) > -1e5f;
-          map_x_.at<float>(v, u) += inside ? static_cast<float>(m) : 0.f;
-          map_y_.at<float>(v, u) += inside ? static_cast<float>(m) : 0.f;
-          uv.at<cv::Vec2f>(v, u) =
-              inside ? cv::Vec2f(static_cast<float>((map_x_.at<float>(v, u) + 0.5) /
-                                                    scene_intrinsics_.width),
-                                 static_cast<float>((map_y_.at<float>(v, u) + 0.5) /
-                                                    scene_intrinsics_.height))
-                     : cv::Vec2f(-1.0f, -1.0f);
-        }
-      }
-      glBindTexture(GL_TEXTURE_2D, distortion_map_);
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, intrinsics_.width, intrinsics_.height, GL_RG,
-                      GL_FLOAT, uv.data);
-    }
+  } else {
+    scene_intrinsics_.width += 2 * margin;
+    scene_intrinsics_.height += 2 * margin;
+    scene_intrinsics_.cx += margin;
+    scene_intrinsics_.cy += margin;
   }
   scene_ = std::make_unique<Target>(scene_intrinsics_.width, scene_intrinsics_.height, gray, true);
   if (post_pass_) {
@@ -464,7 +445,7 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
                  static_cast<GLuint>((frame >> 32) ^ (frame * 0x9E3779B9u)));
     glUniform1f(at("u_exposure_gain"), static_cast<float>(exposureGain(utime)));
     glUniform1f(at("u_vignetting_k"), static_cast<float>(vignettingK()));
-    glUniform4f(at("u_lens_k"), static_cast<float>(intrinsics_.fx),
+    glUniform4f(at("u_output_k"), static_cast<float>(intrinsics_.fx),
                 static_cast<float>(intrinsics_.fy), static_cast<float>(intrinsics_.cx),
                 static_cast<float>(intrinsics_.cy));
     glUniform1f(at("u_response_gamma"),
@@ -484,9 +465,6 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
                   static_cast<float>(scene_intrinsics_.fy),
                   static_cast<float>(scene_intrinsics_.cx),
                   static_cast<float>(scene_intrinsics_.cy));
-      glUniform4f(at("u_output_k"), static_cast<float>(intrinsics_.fx),
-                  static_cast<float>(intrinsics_.fy), static_cast<float>(intrinsics_.cx),
-                  static_cast<float>(intrinsics_.cy));
       glUniform2f(at("u_scene_size"), static_cast<float>(scene_->width),
                   static_cast<float>(scene_->height));
       glUniform2f(at("u_output_size"), static_cast<float>(output_->width),

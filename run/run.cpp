@@ -100,11 +100,11 @@ RunResult runScenario(const RunOptions& options,
   // texture from one frame a second of sim time.
   cv::Mat last_image;
   render::TextureMeter texture;
-  std::int64_t last_measured_utime = 0;
+  std::optional<std::int64_t> last_measured_utime;
   core::Subscription last_image_keeper =
       msg::subscribe<msg::Image>(*bus, scenario.camera.channel, [&](const msg::Image& image) {
         last_image = image.pixels;
-        if (texture.result().frames == 0 || image.utime - last_measured_utime >= 1'000'000) {
+        if (!last_measured_utime || image.utime - *last_measured_utime >= 1'000'000) {
           texture.add(image.pixels);
           last_measured_utime = image.utime;
         }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/frames.h"
+#include "core/hash.h"
 
 namespace nadir::camera {
 
@@ -36,15 +37,10 @@ std::int64_t CameraSpec::stampOf(std::int64_t true_utime) const {
   double jitter_s = 0.0;
   if (timestamp_jitter_s > 0.0) {
     // Box-Muller on two draws of splitmix64 from the seed and the frame's time.
-    std::uint64_t state = static_cast<std::uint64_t>(jitter_seed) * 0x9E3779B97F4A7C15ull ^
-                          static_cast<std::uint64_t>(true_utime);
-    const auto next = [&state] {
-      std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-      return (static_cast<double>((z ^ (z >> 31)) >> 11) + 0.5) / 9007199254740992.0;
-    };
-    const double u1 = next(), u2 = next();
+    const std::uint64_t key = static_cast<std::uint64_t>(jitter_seed) * 0x9E3779B97F4A7C15ull ^
+                              static_cast<std::uint64_t>(true_utime);
+    const double u1 = core::uniformOpen01(core::splitmix64(key));
+    const double u2 = core::uniformOpen01(core::splitmix64(key + 0x9E3779B97F4A7C15ull));
     const double gaussian = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
     jitter_s = timestamp_jitter_s * std::clamp(gaussian, -3.0, 3.0);
   }

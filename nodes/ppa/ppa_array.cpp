@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "core/hash.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -115,12 +117,7 @@ struct WriteWhereFlag {
 
 // ---- noise: counter-based, so a plane depends only on (seed, transfer counter).
 
-inline std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
+using core::splitmix64;
 
 // Box-Muller on pairs of 32-bit uniforms (a[j], b[j]) with polynomial log, sin
 // and cos (errors below 1e-5) and no branches: out[j] and out[j + n] get the pair.

@@ -14,8 +14,6 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // A gyro bias estimate beyond this is the filter running away, not a bias.
 constexpr double kMaxGyroBias_rps = 0.1;
 
-double wrapAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
-
 Eigen::Vector3d horizontal(const Eigen::Vector3d& v) { return {v.x(), v.y(), 0.0}; }
 
 // The heading that the field seen in the body gives, with the tilt of
@@ -25,7 +23,7 @@ double headingFromField(const Eigen::Vector3d& field_body_ut,
   const double yaw = core::rpyFromQuaternion(q_world_body).yaw_rad;
   const Eigen::Vector3d level =
       Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()) * (q_world_body * field_body_ut);
-  return wrapAngle(declination_rad - std::atan2(level.y(), level.x()));
+  return core::wrapAngle_rad(declination_rad - std::atan2(level.y(), level.x()));
 }
 
 bool hasFix(const msg::Gps& gps) { return gps.fix != msg::GpsFix::NONE; }
@@ -122,8 +120,8 @@ void FlightEstimator::addMagnetometer(const msg::Magnetometer& mag) {
     return;
   }
   const double yaw = core::rpyFromQuaternion(q_world_body_).yaw_rad;
-  const double error =
-      wrapAngle(headingFromField(mag.field_body_ut, q_world_body_, declination_rad_) - yaw);
+  const double error = core::wrapAngle_rad(
+      headingFromField(mag.field_body_ut, q_world_body_, declination_rad_) - yaw);
   heading_error_world_ = Eigen::Vector3d(0.0, 0.0, error);
 }
 

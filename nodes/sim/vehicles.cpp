@@ -16,8 +16,6 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // Turns sharper than this (160 deg) are anticipated as if they were this sharp.
 constexpr double kMaxAnticipatedTurn_rad = 2.8;
 
-double wrapAngle(double angle_rad) { return std::remainder(angle_rad, 2.0 * std::numbers::pi); }
-
 Eigen::Vector2d horizontal(const Eigen::Vector3d& p) { return {p.x(), p.y()}; }
 
 // Body rates from Euler angle rates (Z-Y-X), body frame.
@@ -114,7 +112,7 @@ FixedWing::FixedWing(const FixedWingParams& params, const Eigen::Vector3d& start
     const Eigen::Vector2d in = horizontal(waypoints_[i].p_ned_m) - horizontal(from);
     const Eigen::Vector2d out =
         horizontal(waypoints_[i + 1].p_ned_m) - horizontal(waypoints_[i].p_ned_m);
-    return std::abs(wrapAngle(std::atan2(out.y(), out.x()) - std::atan2(in.y(), in.x())));
+    return std::abs(core::wrapAngle_rad(std::atan2(out.y(), out.x()) - std::atan2(in.y(), in.x())));
   };
   for (std::size_t i = 0; i < waypoints_.size(); ++i) {
     const Eigen::Vector3d& from = i == 0 ? start_ned : waypoints_[i - 1].p_ned_m;
@@ -171,8 +169,8 @@ void FixedWing::step() {
     if (next_waypoint_ + 1 < waypoints_.size()) {
       const Eigen::Vector2d next_leg =
           horizontal(waypoints_[next_waypoint_ + 1].p_ned_m) - horizontal(target);
-      const double turn_rad = std::abs(
-          wrapAngle(std::atan2(next_leg.y(), next_leg.x()) - std::atan2(leg.y(), leg.x())));
+      const double turn_rad = std::abs(core::wrapAngle_rad(std::atan2(next_leg.y(), next_leg.x()) -
+                                                           std::atan2(leg.y(), leg.x())));
       lead_m = std::min(
           turnRadius_m(airspeed) * std::tan(0.5 * std::min(turn_rad, kMaxAnticipatedTurn_rad)),
           0.5 * leg.norm());
@@ -191,7 +189,8 @@ void FixedWing::step() {
         horizontal(leg_start_ned_) + (from_start.dot(leg_unit) + params_.lookahead_m) * leg_unit;
     const Eigen::Vector2d to_carrot = carrot - horizontal(p);
     const double course_rad = std::atan2(state_.v_ned_mps.y(), state_.v_ned_mps.x());
-    const double error_rad = wrapAngle(std::atan2(to_carrot.y(), to_carrot.x()) - course_rad);
+    const double error_rad =
+        core::wrapAngle_rad(std::atan2(to_carrot.y(), to_carrot.x()) - course_rad);
     // Turn rate that closes the course error over the lookahead distance; past
     // 90 deg off course, the full rate towards it.
     const double limited_error = std::clamp(error_rad, -std::numbers::pi / 2, std::numbers::pi / 2);
@@ -204,7 +203,7 @@ void FixedWing::step() {
   bank_rad_ += std::clamp(bank_command - bank_rad_, -max_roll_step, max_roll_step);
 
   const double yaw_rate_rps = kGravity_mps2 * std::tan(bank_rad_) / airspeed;
-  heading_rad_ = wrapAngle(heading_rad_ + yaw_rate_rps * dt);
+  heading_rad_ = core::wrapAngle_rad(heading_rad_ + yaw_rate_rps * dt);
 
   const double climb_command = std::clamp(0.5 * (altitude_target_m - (-p.z())),
                                           -params_.max_climb_rate_mps, params_.max_climb_rate_mps);
@@ -273,13 +272,13 @@ void Multirotor::step() {
     const Eigen::Vector3d to_target = waypoints_[next_waypoint_].p_ned_m - state_.p_ned_m;
     const double distance_m = to_target.norm();
     const double leg_course = std::atan2(to_target.y(), to_target.x());
-    const double yaw_error = wrapAngle(leg_course - yaw_rad_);
+    const double yaw_error = core::wrapAngle_rad(leg_course - yaw_rad_);
     const double max_yaw_step = params_.yaw_rate_dps * kDeg * dt;
     const bool must_turn = params_.yaw_at_corners && speed_mps_ == 0.0 &&
                            horizontal(to_target).norm() > 1e-6 && std::abs(yaw_error) > 1e-9;
     if (must_turn) {
       const double yaw_step = std::clamp(yaw_error, -max_yaw_step, max_yaw_step);
-      yaw_rad_ = wrapAngle(yaw_rad_ + yaw_step);
+      yaw_rad_ = core::wrapAngle_rad(yaw_rad_ + yaw_step);
       yaw_rate_rps = yaw_step / dt;
     } else {
       // Accelerate to cruise, brake so as to stop on the waypoint.
@@ -360,7 +359,7 @@ void Rover::step() {
     // Pure pursuit: the arc through the goal point ahead, curvature 2 sin(alpha) / L.
     const Eigen::Vector2d to_goal =
         horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m);
-    const double alpha = wrapAngle(std::atan2(to_goal.y(), to_goal.x()) - heading_rad_);
+    const double alpha = core::wrapAngle_rad(std::atan2(to_goal.y(), to_goal.x()) - heading_rad_);
     const double distance = std::max(std::min(to_goal.norm(), params_.lookahead_m), 1e-6);
     // A goal behind gets the tightest turn towards it, not none.
     const double curvature =
@@ -372,7 +371,7 @@ void Rover::step() {
   steer_rad_ += std::clamp(std::clamp(steer_command, -max_steer, max_steer) - steer_rad_,
                            -max_steer_step, max_steer_step);
   const double yaw_rate_rps = speed * std::tan(steer_rad_) / params_.wheelbase_m;
-  heading_rad_ = wrapAngle(heading_rad_ + yaw_rate_rps * dt);
+  heading_rad_ = core::wrapAngle_rad(heading_rad_ + yaw_rate_rps * dt);
   state_.v_ned_mps = speed * Eigen::Vector3d(std::cos(heading_rad_), std::sin(heading_rad_), 0.0);
   state_.p_ned_m += state_.v_ned_mps * dt;
   state_.a_ned_mps2 = (state_.v_ned_mps - previous_velocity) / dt;
