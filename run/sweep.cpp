@@ -60,6 +60,11 @@ const eval::SourceMetrics* sourceOf(const SweepCell& cell, const std::string& na
 
 }  // namespace
 
+std::vector<std::string> SweepAxis::overrides(std::size_t i) const {
+  if (!variants.empty()) return variants.at(i);
+  return {key + "=" + values.at(i)};
+}
+
 SweepSpec loadSweep(const std::string& path) {
   YAML::Node root;
   try {
@@ -91,13 +96,30 @@ SweepSpec loadSweep(const std::string& path) {
       } else if (key == "axes") {
         if (!value.IsMap()) fail(path, value, key, "expected a map of key: [values]");
         for (const auto& axis : value) {
-          SweepAxis parsed{axis.first.as<std::string>(), {}};
-          if (!axis.second.IsSequence() || axis.second.size() == 0) {
-            fail(path, axis.second, "axes." + parsed.key, "expected a non-empty list of values");
-          }
-          for (const auto& v : axis.second) {
-            if (!v.IsScalar()) fail(path, v, "axes." + parsed.key, "values must be scalars");
-            parsed.values.push_back(v.Scalar());
+          SweepAxis parsed{axis.first.as<std::string>(), {}, {}};
+          const std::string where = "axes." + parsed.key;
+          if (axis.second.IsMap() && axis.second.size() > 0) {
+            for (const auto& variant : axis.second) {
+              const std::string name = variant.first.as<std::string>();
+              if (!variant.second.IsSequence())
+                fail(path, variant.second, where + "." + name, "expected a list of key=value");
+              std::vector<std::string> overrides;
+              for (const auto& v : variant.second) {
+                if (!v.IsScalar() || v.Scalar().find('=') == std::string::npos)
+                  fail(path, v, where + "." + name, "expected key=value, got '" + v.Scalar() + "'");
+                overrides.push_back(v.Scalar());
+              }
+              parsed.values.push_back(name);
+              parsed.variants.push_back(std::move(overrides));
+            }
+          } else if (axis.second.IsSequence() && axis.second.size() > 0) {
+            for (const auto& v : axis.second) {
+              if (!v.IsScalar()) fail(path, v, where, "values must be scalars");
+              parsed.values.push_back(v.Scalar());
+            }
+          } else {
+            fail(path, axis.second, where,
+                 "expected a non-empty list of values or a map of named variants");
           }
           spec.axes.push_back(std::move(parsed));
         }
@@ -163,8 +185,13 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
         argv.push_back(assignment);
       }
       for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-        argv.push_back("--set");
-        argv.push_back(spec.axes[a].key + "=" + cell.values[a]);
+        const SweepAxis& axis = spec.axes[a];
+        const auto value = std::find(axis.values.begin(), axis.values.end(), cell.values[a]);
+        for (const std::string& assignment :
+             axis.overrides(static_cast<std::size_t>(value - axis.values.begin()))) {
+          argv.push_back("--set");
+          argv.push_back(assignment);
+        }
       }
       auto child = std::make_unique<ChildProcess>("run " + std::to_string(next), argv,
                                                   (fs::path(cell.out_dir) / "run.out").string());

@@ -14,6 +14,9 @@
 //     vehicle.airspeed_mps: [10, 25]
 //     vehicle.max_roll_rate_dps: [25, 45, 65]
 //     vehicle.altitude_agl_m: [50, 100, 150, 200, 250, 300, 350, 400]
+//     effect:                      # named variants: each value a list of overrides
+//       ideal: []
+//       noise: [camera.read_noise_counts=2, camera.shot_noise_electrons_per_count=10]
 
 #include <functional>
 #include <optional>
@@ -25,9 +28,15 @@
 
 namespace nadir::run {
 
+// A parameter and its values, or (variants non-empty) a label and named
+// variants, each a list of overrides; values then holds the variants' names.
 struct SweepAxis {
   std::string key;
   std::vector<std::string> values;
+  std::vector<std::vector<std::string>> variants = {};
+
+  // The overrides the axis's i-th value stands for.
+  std::vector<std::string> overrides(std::size_t i) const;
 };
 
 struct SweepSpec {

@@ -50,6 +50,14 @@ void DirectVoParams::visit(core::ParamVisitor& v) {
            .max = 100});
   v.field("lost_min_in_image", &lost_min_in_image,
           {.doc = "a frame keeping fewer of the points in the image is lost", .min = 0, .max = 1});
+  v.field("lost_pose_sigma_px", &lost_pose_sigma_px,
+          {.doc = "lost when the image fixes the pose to worse than this, 1-sigma image motion, px",
+           .min = 1e-3,
+           .max = 1e6});
+  v.field("lost_speed_mps", &lost_speed_mps,
+          {.doc = "lost when the camera moved faster than this since the last good frame, m/s",
+           .min = 0.1,
+           .max = 1e6});
   v.field("lost_frames_before_reset", &lost_frames_before_reset,
           {.doc = "lost frames in a row before the map is made again", .min = 1, .max = 1000});
   v.field("range_window_px", &range_window_px,
@@ -171,6 +179,7 @@ void DirectVo::acceptPose(const Eigen::Isometry3d& T_cam_world, const AffineBrig
     delta_ = step;
   }
   T_cam_world_last_ = T_cam_world;
+  last_good_time_s_ = frame_time_s_;
   affine_last_ = affine;
   frames_since_good_ = 1;
   lost_count_ = 0;
@@ -184,6 +193,7 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
   T_body_cam.linear() = in.R_body_cam;
   T_body_cam_ = T_body_cam;
   K_ = in.K;
+  frame_time_s_ = static_cast<double>(in.utime) * 1e-6;
 
   auto t0 = Clock::now();
   auto pyramid =
@@ -201,6 +211,7 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
     pending_is_reset_ = false;
     started_ = true;
     T_cam_world_last_ = T_cam_world;
+    last_good_time_s_ = frame_time_s_;
     frames_since_good_ = 1;
     lost_count_ = 0;
     unconfirmed_ = false;
@@ -236,17 +247,23 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
   unconfirmed_ = false;
   typical_rms_ = typical_rms_ > 0.0 ? 0.9 * typical_rms_ + 0.1 * result.rms : result.rms;
   const Eigen::Isometry3d T_cam_world = orthonormalized(result.T_frame_ref * kf.T_cam_world);
+  // A frame the image fixes too loosely is reported lost but kept: making
+  // the map again over the same faint ground would not fix the pose better.
+  const VoStatus status =
+      result.pose_sigma_px > params_.lost_pose_sigma_px ? VoStatus::kLost : VoStatus::kTracking;
   if (needKeyframe(result)) {
     addKeyframe(std::move(pyramid), in, T_cam_world, result.affine);
     const Eigen::Isometry3d refined = keyframes_.back().T_cam_world;
     acceptPose(refined, keyframes_.back().affine);
-    DirectVoOutput out = output(VoStatus::kTracking, refined, result.points, true);
+    DirectVoOutput out = output(status, refined, result.points, true);
     out.rms = result.rms;
+    out.pose_sigma_px = result.pose_sigma_px;
     return out;
   }
   acceptPose(T_cam_world, result.affine);
-  DirectVoOutput out = output(VoStatus::kTracking, T_cam_world, result.points, false);
+  DirectVoOutput out = output(status, T_cam_world, result.points, false);
   out.rms = result.rms;
+  out.pose_sigma_px = result.pose_sigma_px;
   return out;
 }
 
@@ -269,6 +286,7 @@ DirectVoOutput DirectVo::lostFrame(std::unique_ptr<ImagePyramid> pyramid, const 
     // The motion model flies on from here.
     const Eigen::Isometry3d delta = delta_;
     T_cam_world_last_ = T_pred;
+    last_good_time_s_ = frame_time_s_;
     frames_since_good_ = 1;
     delta_ = delta;
   }
@@ -299,7 +317,13 @@ TrackResult DirectVo::track(const ImagePyramid& pyramid) {
 
 bool DirectVo::isLost(const TrackResult& r) const {
   const double rms_limit = std::max(params_.lost_rms_floor, params_.lost_rms_ratio * typical_rms_);
+  const Eigen::Isometry3d T_cam_world = r.T_frame_ref * keyframes_.back().T_cam_world;
+  const double moved_m =
+      (T_cam_world.inverse().translation() - T_cam_world_last_.inverse().translation()).norm();
+  // At least 1 ms: frames with the same stamp still compare.
+  const double elapsed_s = std::max(frame_time_s_ - last_good_time_s_, 1e-3);
   return r.points < 20 || r.rms > rms_limit || r.in_image_share < params_.lost_min_in_image ||
+         moved_m > params_.lost_speed_mps * elapsed_s ||
          std::fabs(r.affine.a - keyframes_.back().affine.a) > params_.lost_log_gain ||
          !r.T_frame_ref.matrix().allFinite();
 }

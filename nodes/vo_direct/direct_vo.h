@@ -55,11 +55,22 @@ struct DirectVoParams {
   // map's typical one (a running mean over the frames tracked) and
   // lost_rms_floor, when its brightness changes by more than lost_log_gain
   // from the key-frame's (a blinded or noisy image is matched by a gain near
-  // zero), or when fewer than lost_min_in_image of the points stay in the image.
+  // zero), or when fewer than lost_min_in_image of the points stay in the
+  // image; after lost_frames_before_reset of those the map is made again.
+  // A frame is also reported lost, but its pose and the map kept, when the
+  // image fixes the pose too loosely: its least-determined direction moves
+  // the image by more than lost_pose_sigma_px at 1 sigma (level-0 px;
+  // TrackResult::pose_sigma_px). Over low-texture ground the estimate drifts
+  // away with every frame otherwise "tracked" (docs/vo_direct.md).
   double lost_rms_ratio = 3.0;
   double lost_rms_floor = 10.0;
   double lost_log_gain = 0.7;
   double lost_min_in_image = 0.2;
+  double lost_pose_sigma_px = 0.2;
+  // A frame whose pose puts the camera further from the last good one than
+  // this speed allows is lost: no vehicle nadir flies is faster, and a pose
+  // fitted to faint texture can leap by kilometres.
+  double lost_speed_mps = 150.0;
   // Lost frames in a row before the map is dropped and made again.
   int lost_frames_before_reset = 3;
   // Points of a key-frame within this of the rangefinder ray's image carry
@@ -92,6 +103,8 @@ struct DirectVoOutput {
   int resets = 0;
   AffineBrightness affine;  // the frame's brightness
   double rms = 0.0;         // the alignment's RMS residual
+  // How loosely the image fixes the pose (TrackResult::pose_sigma_px).
+  double pose_sigma_px = 0.0;
 };
 
 class DirectVo {
@@ -168,6 +181,9 @@ class DirectVo {
   // Motion model: the last good camera pose (T_cam_world), the motion per
   // frame (T_cam_world(k+1) = delta * T_cam_world(k)) and the frames since.
   Eigen::Isometry3d T_cam_world_last_ = Eigen::Isometry3d::Identity();
+  // Time of the last good frame and of the frame being processed, s.
+  double last_good_time_s_ = 0.0;
+  double frame_time_s_ = 0.0;
   Eigen::Isometry3d delta_ = Eigen::Isometry3d::Identity();
   AffineBrightness affine_last_;
   int frames_since_good_ = 1;

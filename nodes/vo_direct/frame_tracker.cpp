@@ -1,5 +1,8 @@
 #include "nodes/vo_direct/frame_tracker.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -239,6 +242,21 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
   return sys;
 }
 
+// See TrackResult::pose_sigma_px. xi = (translation, rotation).
+double poseSigmaPx(const Matrix8d& H, double rms, double focal_px, double mean_idepth) {
+  const Eigen::LDLT<Matrix8d> ldlt(H);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return 1e9;
+  const Matrix8d covariance = ldlt.solve(Matrix8d::Identity()) * (rms * rms);
+  if (!covariance.allFinite()) return 1e9;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> translation(covariance.topLeftCorner<3, 3>(),
+                                                                   Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rotation(covariance.block<3, 3>(3, 3),
+                                                                Eigen::EigenvaluesOnly);
+  const double sigma_t = std::sqrt(std::max(0.0, translation.eigenvalues().maxCoeff()));
+  const double sigma_r = std::sqrt(std::max(0.0, rotation.eigenvalues().maxCoeff()));
+  return focal_px * (sigma_r + sigma_t * mean_idepth);
+}
+
 }  // namespace
 
 TrackResult trackFrame(const TrackingReference& reference, const ImagePyramid& frame,
@@ -302,6 +320,9 @@ TrackResult trackFrame(const TrackingReference& reference, const ImagePyramid& f
     result.in_image_share =
         sys.points_total > 0 ? static_cast<double>(sys.points_in) / sys.points_total : 0.0;
     result.points = sys.points_in;
+    if (l == finest)
+      result.pose_sigma_px =
+          poseSigmaPx(sys.H, rms, reference.cameras[l].fx * (1 << l), reference.mean_idepth);
   }
   result.T_frame_ref = T;
   result.affine = affine;

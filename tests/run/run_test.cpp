@@ -256,6 +256,45 @@ TEST(Sweep, PlansTheGrid) {
             "cell_001_airspeed_mps=10_max_roll_rate_dps=25_altitude_agl_m=100");
 }
 
+// An axis of named variants: each cell takes its variant's overrides, and is
+// named and tabulated by the variant's name; a variant that is not key=value
+// is refused with its line.
+TEST(Sweep, PlansNamedVariants) {
+  const std::string dir = tempDir("sweep_variants");
+  fs::create_directories(dir);
+  const std::string path = (fs::path(dir) / "sweep.yaml").string();
+  std::ofstream(path) << "scenario: thesis-oscillating\nout: " << dir
+                      << "\naxes:\n"
+                         "  effect:\n"
+                         "    ideal: []\n"
+                         "    noise: [camera.read_noise_counts=2, "
+                         "camera.shot_noise_electrons_per_count=10]\n"
+                         "  vehicle.altitude_agl_m: [100, 300]\n";
+  const SweepSpec spec = loadSweep(path);
+  ASSERT_EQ(spec.axes.size(), 2u);
+  EXPECT_EQ(spec.axes[0].values, (std::vector<std::string>{"ideal", "noise"}));
+  EXPECT_TRUE(spec.axes[0].overrides(0).empty());
+  EXPECT_EQ(spec.axes[0].overrides(1),
+            (std::vector<std::string>{"camera.read_noise_counts=2",
+                                      "camera.shot_noise_electrons_per_count=10"}));
+  EXPECT_EQ(spec.axes[1].overrides(1), (std::vector<std::string>{"vehicle.altitude_agl_m=300"}));
+  const std::vector<SweepCell> cells = planSweep(spec);
+  ASSERT_EQ(cells.size(), 4u);
+  EXPECT_EQ(fs::path(cells[3].out_dir).filename(), "cell_003_effect=noise_altitude_agl_m=300");
+  EXPECT_NE(sweepMarkdown(spec, cells).find("| effect | vehicle.altitude_agl_m |"),
+            std::string::npos);
+
+  std::ofstream(path, std::ios::trunc) << "scenario: box\naxes:\n  effect:\n    blur: [on]\n";
+  try {
+    loadSweep(path);
+    FAIL() << "no error";
+  } catch (const core::ParamError& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ":4: axes.effect.blur: expected key=value"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 // A sweep file with an unknown key or an empty axis is refused with the line named.
 TEST(Sweep, BadFilesAreRefused) {
   const std::string dir = tempDir("sweep_bad");
