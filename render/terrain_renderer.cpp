@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "render/detail_texture.h"
+#include "render/ground_objects.h"
 #include "render/gl.h"
 
 namespace nadir::render {
@@ -147,6 +148,8 @@ struct TerrainRenderer::GpuTile {
   std::size_t bytes = 0;
   terrain::GroundSquare square;
   std::list<std::uint64_t>::iterator lru_position;
+  // The tile's trees and buildings, when objects_3d and its texel is fine enough.
+  std::unique_ptr<ObjectInstances> objects;
 
   ~GpuTile() {
     glDeleteTextures(1, &texture);
@@ -175,6 +178,13 @@ void TerrainRendererParams::visit(core::ParamVisitor& v) {
   v.field(
       "detail_contrast", &detail_contrast,
       {.doc = "contrast of the texture added below the imagery's resolution", .min = 0, .max = 1});
+  v.field("objects_3d", &objects_3d,
+          {.doc = "trees and buildings stand up as 3D objects with their heights"});
+  v.field("objects_max_texel_m", &objects_max_texel_m,
+          {.doc = "objects are drawn on tiles whose texel is at most this, m (farther: imagery "
+                  "only)",
+           .min = 0.01,
+           .max = 1000});
 }
 
 TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
@@ -227,12 +237,14 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  if (params_.objects_3d) objects_ = std::make_unique<GroundObjectRenderer>();
   checkGl("creating the terrain renderer");
 }
 
 TerrainRenderer::~TerrainRenderer() {
   gpu_tiles_.clear();
   targets_.clear();
+  objects_.reset();
   glDeleteProgram(program_target_);
   glDeleteTextures(1, &detail_texture_);
   glDeleteBuffers(1, &index_buffer_);
@@ -309,6 +321,32 @@ void TerrainRenderer::drawTargets(const DrawView& view, const Eigen::Matrix4d& c
   glEnable(GL_DEPTH_TEST);
 }
 
+void TerrainRenderer::drawObjects(const DrawView& view, const Eigen::Matrix4d& clip_from_camera,
+                                  const std::vector<terrain::TileId>& visible, DrawStats& stats) {
+  const Eigen::Vector3d camera_ned = view.T_world_cam.translation();
+  const Eigen::Matrix3d R_cam_world = view.T_world_cam.rotation().transpose();
+  const double focal_px = std::max(view.intrinsics.fx, view.intrinsics.fy);
+  objects_->begin(tiles_->world().sunDirectionNed(), view.gain, view.gray);
+  for (const terrain::TileId& id : visible) {
+    const auto found = gpu_tiles_.find(id.key());
+    if (found == gpu_tiles_.end() || !found->second->objects) continue;
+    const GpuTile& tile = *found->second;
+    // Fine meshes while a 4 m crown at the tile's nearest point spans 16 px or more.
+    const double nearest_m = std::max(tiles_->geometry(id)->distanceFrom_m(camera_ned), 1.0);
+    const ObjectDetail detail =
+        4.0 * focal_px / nearest_m >= 16.0 ? ObjectDetail::kFine : ObjectDetail::kCoarse;
+    const Eigen::Vector3d origin_ned(tile.square.north_min_m, tile.square.east_min_m, 0.0);
+    Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
+    camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
+    camera_from_local.topRightCorner<3, 1>() = R_cam_world * (origin_ned - camera_ned);
+    const Eigen::Matrix4f clip = (clip_from_camera * camera_from_local).cast<float>();
+    const ObjectDrawStats drawn = objects_->draw(*tile.objects, clip.data(), detail);
+    stats.objects += drawn.objects;
+    stats.triangles += drawn.triangles;
+  }
+  objects_->end();
+}
+
 terrain::LodView lodViewOf(const DrawView& view) {
   terrain::LodView lod;
   lod.camera_ned = view.T_world_cam.translation();
@@ -378,12 +416,21 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer_);
   glBindVertexArray(0);
 
-  const cv::Mat rgb = tiles_->imagery(id);
+  // Where the objects stand up, the imagery leaves out their tops.
+  const bool objects =
+      objects_ && geometry->square.size_m / tiles_->params().texture_px <= params_.objects_max_texel_m;
+  const cv::Mat rgb = tiles_->imagery(id, objects);
   // Nearest mip level, bilinear within it: cheaper than trilinear on llvmpipe,
   // and the tile choice keeps the level near 0 (a texel about a pixel).
   tile->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_NEAREST);
   tile->bytes =
       vertices.size() * sizeof(float) + static_cast<std::size_t>(rgb.cols) * rgb.rows * 4 * 4 / 3;
+  if (objects) {
+    tile->objects = std::make_unique<ObjectInstances>(
+        tiles_->world().objects(tile->square),
+        Eigen::Vector3d(tile->square.north_min_m, tile->square.east_min_m, 0.0));
+    tile->bytes += tile->objects->bytes();
+  }
   gpu_bytes_ += tile->bytes;
   lru_.push_front(key);
   tile->lru_position = lru_.begin();
@@ -484,6 +531,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
     }
   }
   glBindVertexArray(0);
+  if (objects_) drawObjects(view, P, visible, stats);
   drawTargets(view, P);
   evictBeyondBudget(visible);
   checkGl("drawing the terrain");

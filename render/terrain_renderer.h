@@ -18,11 +18,18 @@
 
 namespace nadir::render {
 
+class GroundObjectRenderer;
+
 struct TerrainRendererParams {
   // GPU memory for tile meshes and textures, MiB (system memory on llvmpipe).
   double tile_cache_mib = 512.0;
   // Strength of the sub-imagery detail, 0..1 (contrast of the detail pattern).
   double detail_contrast = 0.1;
+  // Trees and buildings stand up as 3D objects (World::objects) on tiles whose
+  // texel is at most objects_max_texel_m; coarser tiles are far enough that
+  // the imagery's tops alone are drawn.
+  bool objects_3d = false;
+  double objects_max_texel_m = 1.5;
 
   void visit(core::ParamVisitor& v);
 };
@@ -42,8 +49,9 @@ struct DrawView {
 
 struct DrawStats {
   int tiles = 0;
-  int triangles = 0;
+  int triangles = 0;  // the terrain's and the objects'
   int tiles_uploaded = 0;
+  int objects = 0;
 };
 
 class TerrainRenderer {
@@ -83,6 +91,9 @@ class TerrainRenderer {
   void drawTargets(const DrawView& view, const Eigen::Matrix4d& clip_from_camera);
   unsigned int program_target_ = 0;
   std::vector<std::unique_ptr<GpuTarget>> targets_;
+  void drawObjects(const DrawView& view, const Eigen::Matrix4d& clip_from_camera,
+                   const std::vector<terrain::TileId>& visible, DrawStats& stats);
+  std::unique_ptr<GroundObjectRenderer> objects_;
   std::unordered_map<std::uint64_t, std::unique_ptr<GpuTile>> gpu_tiles_;
   std::list<std::uint64_t> lru_;
   std::size_t gpu_bytes_ = 0;

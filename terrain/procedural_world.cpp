@@ -99,6 +99,16 @@ double ProceduralWorld::groundUp_m(double north_m, double east_m) const {
 }
 
 void ProceduralWorld::imagery(const GroundSquare& square, int size_px, cv::Mat& rgb) const {
+  drawImagery(square, size_px, true, rgb);
+}
+
+void ProceduralWorld::imageryBeneathObjects(const GroundSquare& square, int size_px,
+                                            cv::Mat& rgb) const {
+  drawImagery(square, size_px, false, rgb);
+}
+
+void ProceduralWorld::drawImagery(const GroundSquare& square, int size_px, bool tops,
+                                  cv::Mat& rgb) const {
   if (size_px <= 0 || !(square.size_m > 0.0) || !std::isfinite(square.size_m) ||
       !std::isfinite(square.north_min_m) || !std::isfinite(square.east_min_m)) {
     throw std::invalid_argument("ProceduralWorld::imagery: needs size_px > 0 and a finite square");
@@ -113,6 +123,7 @@ void ProceduralWorld::imagery(const GroundSquare& square, int size_px, cv::Mat& 
       pf.east_min = square.east_min_m;
       pf.north_min = square.north_min_m;
       pf.px = square.size_m / size_px;
+      pf.tops = tops;
       pf.size_px = size_px;
       pf.r0 = br * kBlockPx;
       pf.c0 = bc * kBlockPx;
@@ -130,6 +141,65 @@ double ProceduralWorld::elevationResolution_m() const { return 4.0; }
 WorldExtent ProceduralWorld::extent() const {
   const double half = 0.5 * impl_->gen.p.size_m;
   return {-half, half, -half, half};
+}
+
+std::vector<GroundObject> ProceduralWorld::objects(const GroundSquare& square) const {
+  if (!(square.size_m > 0.0) || !std::isfinite(square.size_m) ||
+      !std::isfinite(square.north_min_m) || !std::isfinite(square.east_min_m)) {
+    throw std::invalid_argument("ProceduralWorld::objects: needs a finite, non-empty square");
+  }
+  const procedural::Generator& gen = impl_->gen;
+  const double n0 = square.north_min_m, e0 = square.east_min_m, size = square.size_m;
+  const auto inside = [&](double east, double north) {
+    return north >= n0 && north < n0 + size && east >= e0 && east < e0 + size;
+  };
+  // Internally x is east and y north.
+  const procedural::WorldBox box{e0, n0, e0 + size, n0 + size};
+  const auto colour = [](const procedural::Rgb& c) {
+    const auto channel = [](double v) {
+      return static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+    };
+    return std::array<std::uint8_t, 3>{channel(c.r), channel(c.g), channel(c.b)};
+  };
+  std::vector<GroundObject> out;
+  std::vector<procedural::Tree> trees;
+  gen.collectTrees(box, procedural::TreeDraw{}, trees);
+  for (const procedural::Tree& t : trees) {
+    if (!inside(t.x, t.y) || t.alpha <= 0.0) continue;
+    GroundObject o;
+    o.kind = t.conifer ? GroundObject::Kind::kConifer : GroundObject::Kind::kBroadleaf;
+    o.north_m = t.y;
+    o.east_m = t.x;
+    o.base_up_m = groundUp_m(t.y, t.x);
+    o.height_m = t.height;
+    o.half_length_m = o.half_width_m = t.r;
+    o.rgb = colour(t.colour);
+    out.push_back(o);
+  }
+  // A farmstead's buildings lie within about 100 m of the cell that places it.
+  std::vector<procedural::Building> buildings;
+  std::vector<procedural::Yard> yards;
+  gen.collectBuildings(box.grown(150.0), buildings, yards);
+  for (const procedural::Building& b : buildings) {
+    if (!inside(b.x, b.y)) continue;
+    GroundObject o;
+    o.kind = GroundObject::Kind::kBuilding;
+    o.north_m = b.y;
+    o.east_m = b.x;
+    o.base_up_m = groundUp_m(b.y, b.x);
+    o.height_m = b.height;
+    o.half_length_m = b.hl;
+    o.half_width_m = b.hw;
+    o.heading_rad = std::atan2(b.ux, b.uy);
+    o.gable = b.gable;
+    o.rgb = colour(b.roof);
+    out.push_back(o);
+  }
+  return out;
+}
+
+std::array<double, 3> ProceduralWorld::sunDirectionNed() const {
+  return World::sunDirectionNed(impl_->gen.p.sun_azimuth_deg, impl_->gen.p.sun_elevation_deg);
 }
 
 const ProceduralWorldParams& ProceduralWorld::params() const { return impl_->gen.p; }

@@ -179,12 +179,17 @@ void TileTree::selectInto(const TileId& id, const LodView& view, std::vector<Til
   out.push_back(id);
 }
 
-cv::Mat TileTree::imagery(const TileId& id) const {
+cv::Mat TileTree::imagery(const TileId& id, bool beneath_objects) const {
   const GroundSquare sq = squareOf(id);
   const double texel_m = sq.size_m / params_.texture_px;
+  const GroundSquare bordered{sq.north_min_m - texel_m, sq.east_min_m - texel_m,
+                              sq.size_m + 2 * texel_m};
   cv::Mat rgb;
-  world_->imagery({sq.north_min_m - texel_m, sq.east_min_m - texel_m, sq.size_m + 2 * texel_m},
-                  params_.texture_px + 2, rgb);
+  if (beneath_objects) {
+    world_->imageryBeneathObjects(bordered, params_.texture_px + 2, rgb);
+  } else {
+    world_->imagery(bordered, params_.texture_px + 2, rgb);
+  }
   return rgb;
 }
 

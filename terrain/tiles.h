@@ -92,7 +92,8 @@ class TileTree {
 
   // The texture of a tile: (texture_px + 2)^2 RGB, the border texel one texel
   // outside the tile's square on each side, north up (row 0 at the north).
-  cv::Mat imagery(const TileId& id) const;
+  // beneath_objects: World::imageryBeneathObjects.
+  cv::Mat imagery(const TileId& id, bool beneath_objects = false) const;
 
   std::size_t geometryCacheBytes() const;
   std::size_t geometryCacheEntries() const;

@@ -6,6 +6,11 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
 namespace nadir::terrain {
 
 // A square of ground in the world frame: north in [north_min_m, north_min_m +
@@ -29,6 +34,25 @@ struct WorldExtent {
   }
 };
 
+// A thing standing on the ground with its real height, for drawing in 3D: a
+// tree (a crown on a trunk) or a building (walls under a flat or gable roof).
+// World frame (NED), metres.
+struct GroundObject {
+  enum class Kind : std::uint8_t { kBroadleaf, kConifer, kBuilding };
+  Kind kind = Kind::kBroadleaf;
+  double north_m = 0.0;
+  double east_m = 0.0;
+  double base_up_m = 0.0;  // the ground's height at its centre
+  double height_m = 0.0;   // its top above base_up_m
+  // Trees: the crown's radius (both); buildings: half the length and width.
+  double half_length_m = 0.0;
+  double half_width_m = 0.0;
+  // Buildings: the long axis, rad clockwise from north.
+  double heading_rad = 0.0;
+  bool gable = false;
+  std::array<std::uint8_t, 3> rgb{};  // unlit colour, sRGB
+};
+
 class World {
  public:
   virtual ~World() = default;
@@ -44,6 +68,13 @@ class World {
   // pixel centres at the centres of size_px x size_px equal cells. Deterministic:
   // the same square and size give the same pixels. Thread-safe.
   virtual void imagery(const GroundSquare& square, int size_px, cv::Mat& rgb) const = 0;
+  // The same with the tops of objects() (crowns, roofs) left out and their
+  // shadows kept: the ground beneath them, for a renderer that draws them in
+  // 3D. By default imagery().
+  virtual void imageryBeneathObjects(const GroundSquare& square, int size_px,
+                                     cv::Mat& rgb) const {
+    imagery(square, size_px, rgb);
+  }
 
   // Ground sample distance of the finest imagery the world holds, m/px.
   virtual double imageryResolution_m() const = 0;
@@ -51,6 +82,24 @@ class World {
   virtual double elevationResolution_m() const = 0;
 
   virtual WorldExtent extent() const = 0;
+
+  // The objects whose centre lies in the square (north in [north_min_m,
+  // north_min_m + size_m), east likewise), in a fixed order: so the squares
+  // of a partition hold each object once. Deterministic and thread-safe.
+  // Their shadows and tops are already in imagery(); real terrain has none.
+  virtual std::vector<GroundObject> objects(const GroundSquare& /*square*/) const { return {}; }
+
+  // Unit vector towards the sun in the world frame (NED): the light objects()
+  // are drawn under, the one imagery() was shaded with. By default the
+  // procedural world's default sun (azimuth 150 deg, elevation 45 deg).
+  virtual std::array<double, 3> sunDirectionNed() const {
+    return sunDirectionNed(150.0, 45.0);
+  }
+  static std::array<double, 3> sunDirectionNed(double azimuth_deg, double elevation_deg) {
+    const double az = azimuth_deg * 3.14159265358979323846 / 180.0;
+    const double el = elevation_deg * 3.14159265358979323846 / 180.0;
+    return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), -std::sin(el)};
+  }
 };
 
 // Height of a point (world frame, NED) above the ground below it, m: what a

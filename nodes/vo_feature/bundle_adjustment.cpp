@@ -73,8 +73,11 @@ class ReprojectionCost {
 // sigma.
 class RotationPriorCost {
  public:
-  RotationPriorCost(const Eigen::Quaterniond& R_ab, double sigma_rad)
-      : R_ba_prior_(R_ab.normalized().conjugate()), inv_sigma_(1.0 / sigma_rad) {}
+  RotationPriorCost(const Eigen::Quaterniond& R_ab, double sigma_rad, double sigma_about_a_z_rad)
+      : R_ab_prior_(R_ab.normalized()),
+        R_ba_prior_(R_ab.normalized().conjugate()),
+        inv_sigma_(1.0 / sigma_rad),
+        inv_sigma_z_(1.0 / (sigma_about_a_z_rad > 0.0 ? sigma_about_a_z_rad : sigma_rad)) {}
 
   template <typename T>
   bool operator()(const T* q_world_cam_a, const T* q_world_cam_b, T* residual) const {
@@ -82,16 +85,21 @@ class RotationPriorCost {
     const Eigen::Map<const Eigen::Quaternion<T>> q_b(q_world_cam_b);
     const Eigen::Quaternion<T> q_err = R_ba_prior_.cast<T>() * (q_a.conjugate() * q_b);
     const T wxyz[4] = {q_err.w(), q_err.x(), q_err.y(), q_err.z()};
-    ceres::QuaternionToAngleAxis(wxyz, residual);
-    for (int i = 0; i < 3; ++i) {
-      residual[i] *= T(inv_sigma_);
-    }
+    Eigen::Matrix<T, 3, 1> error_b;
+    ceres::QuaternionToAngleAxis(wxyz, error_b.data());
+    // In a's axes, where the heading is the part about z.
+    const Eigen::Matrix<T, 3, 1> error_a = R_ab_prior_.cast<T>() * error_b;
+    residual[0] = error_a.x() * T(inv_sigma_);
+    residual[1] = error_a.y() * T(inv_sigma_);
+    residual[2] = error_a.z() * T(inv_sigma_z_);
     return true;
   }
 
  private:
+  Eigen::Quaterniond R_ab_prior_;
   Eigen::Quaterniond R_ba_prior_;
   double inv_sigma_;
+  double inv_sigma_z_;
 };
 
 // The reprojection error in px, or nothing when the point is not in front.
@@ -142,6 +150,10 @@ void validate(const BaProblem& problem) {
     }
     if (!(prior.sigma_rad > 0.0) || !std::isfinite(prior.sigma_rad)) {
       throw std::invalid_argument("bundleAdjust: a rotation prior's sigma_rad must be positive");
+    }
+    if (!(prior.sigma_about_a_z_rad >= 0.0) || !std::isfinite(prior.sigma_about_a_z_rad)) {
+      throw std::invalid_argument(
+          "bundleAdjust: a rotation prior's sigma_about_a_z_rad must be 0 or positive");
     }
   }
 }
@@ -258,7 +270,7 @@ PassReport solvePass(const BaProblem& problem, const BundleAdjustmentParams& par
     }
     const BaRotationPrior& prior = problem.rotation_priors[i];
     auto* cost = new ceres::AutoDiffCostFunction<RotationPriorCost, 3, 4, 4>(
-        new RotationPriorCost(prior.R_ab, prior.sigma_rad));
+        new RotationPriorCost(prior.R_ab, prior.sigma_rad, prior.sigma_about_a_z_rad));
     ceres_problem.AddResidualBlock(cost, nullptr, state.cameras[prior.camera_a].q_world_cam.data(),
                                    state.cameras[prior.camera_b].q_world_cam.data());
   }

@@ -81,6 +81,9 @@ struct BaRotationPrior {
   int camera_b = 0;
   Eigen::Quaterniond R_ab = Eigen::Quaterniond::Identity();
   double sigma_rad = 0.01;
+  // The error's part about camera a's z axis (for an absolute attitude, a
+  // with the world's axes: about down, the heading) has this sigma; 0: sigma_rad.
+  double sigma_about_a_z_rad = 0.0;
 };
 
 struct BaProblem {

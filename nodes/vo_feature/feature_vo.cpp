@@ -88,7 +88,11 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
   v.field("lost_frames_before_reset", &lost_frames_before_reset,
           {.doc = "consecutive lost frames before re-initialising", .min = 1, .max = 100000});
   v.field("attitude_prior_sigma_deg", &attitude_prior_sigma_deg,
-          {.doc = "standard deviation of the attitude prior in tracking and local BA, deg",
+          {.doc = "standard deviation of the attitude prior's tilt in tracking and local BA, deg",
+           .min = 1e-3,
+           .max = 180.0});
+  v.field("attitude_prior_heading_sigma_deg", &attitude_prior_heading_sigma_deg,
+          {.doc = "standard deviation of the attitude prior's heading, deg",
            .min = 1e-3,
            .max = 180.0});
   v.field("reinit_from_range", &reinit_from_range,
@@ -151,7 +155,8 @@ void FeatureVo::addAttitudePriors(BaProblem& problem,
     }
     problem.rotation_priors.push_back({world_axes, static_cast<int>(k),
                                        *frames[k]->q_world_cam_prior,
-                                       params_.attitude_prior_sigma_deg * kRadPerDeg});
+                                       params_.attitude_prior_sigma_deg * kRadPerDeg,
+                                       params_.attitude_prior_heading_sigma_deg * kRadPerDeg});
   }
 }
 

@@ -60,9 +60,14 @@ struct FeatureVoParams {
   double pnp_reprojection_px = 3.0;
   // Consecutive lost frames before the map is dropped and the VO re-initialises.
   int lost_frames_before_reset = 5;
-  // Standard deviation of the attitude prior (the flight controller's attitude)
-  // in tracking and in the local bundle adjustment, deg.
+  // Standard deviation of the attitude prior's tilt (the flight controller's
+  // attitude) in tracking and in the local bundle adjustment, deg ...
   double attitude_prior_sigma_deg = 0.5;
+  // ... of its heading, deg. A flight controller's heading comes from the
+  // magnetometer with a bias of a degree or two that vision cannot see; held
+  // to it, the estimate drifts off sideways (docs/vo_feature.md), so by
+  // default only the tilt counts.
+  double attitude_prior_heading_sigma_deg = 90.0;
   // After a loss, with a range: start the new map at once from the ground the
   // rangefinder sees (every feature's ray met with the level plane through the
   // range's ground point), not by two-view initialisation.

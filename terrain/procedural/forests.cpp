@@ -264,6 +264,7 @@ Tree makeTree(const Generator& gen, const TreeSite& s, const TreeChoice& ch, boo
   if (!force) t.colour = t.colour * (1.0 + 0.25 * var + 0.18 * gen.stand(x, y));
   t.r = size * (conifer ? 1.8 + 1.1 * uniform(h, 6) : 3.2 + 2.0 * uniform(h, 6));
   const double height = (conifer ? 14.0 : 10.0) + 8.0 * uniform(h, 7);
+  t.height = height;
   // The crown, a ball of radius r at height - r, casts an ellipse; the
   // trunk a thin line up to it. Inside a forest only the top few metres
   // stand out of the canopy.
@@ -417,7 +418,7 @@ void Generator::drawTrees(const std::vector<Tree>& trees, const PixelFrame& pf,
                           std::vector<float>& shadow) const {
   // Shadows first (into the shadow buffer), then crowns in order.
   drawTreeShadows(*this, trees, pf, fcov, shadow);
-  drawCrowns(*this, trees, pf, col);
+  if (pf.tops) drawCrowns(*this, trees, pf, col);
 }
 
 Rgb Generator::calibrateForest(double conifer_share) const {

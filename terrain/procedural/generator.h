@@ -117,6 +117,7 @@ struct FieldHit {
 
 struct Tree {
   double x, y, r;
+  double height;        // the crown's top above the ground, m
   double shadow_short;  // shadow length on surrounding canopy, m
   double crown_off;     // crown shadow's centre along the shadow direction, m
   double crown_half;    // half the elongation of the crown's shadow, m
@@ -222,6 +223,8 @@ struct SmoothGrid {
 // Pixel centres of a block of an imagery square, from global pixel indices.
 struct PixelFrame {
   double east_min = 0, north_min = 0, px = 1;
+  // Draw the crowns and roofs (false: their shadows only, for 3D objects).
+  bool tops = true;
   int size_px = 1, r0 = 0, c0 = 0, rows = 0, cols = 0;
   double x(int c) const { return east_min + (c0 + c + 0.5) * px; }
   double y(int r) const { return north_min + (size_px - (r0 + r) - 0.5) * px; }

@@ -160,7 +160,7 @@ void Generator::drawSprites(const PixelFrame& pf, const PixelScale& sc, Scratch&
   }
   if (alpha_bld > 0.0) drawBuildingShadows(buildings, pf, alpha_bld, scratch.shadow);
   applyShadows(scratch);
-  if (alpha_bld > 0.0) drawRoofs(buildings, pf, alpha_bld, scratch.col);
+  if (alpha_bld > 0.0 && pf.tops) drawRoofs(buildings, pf, alpha_bld, scratch.col);
 }
 
 void Generator::renderBlock(const PixelFrame& pf, cv::Mat& out) const {

@@ -178,6 +178,72 @@ TEST(CameraRenderer, DepthIsDistanceAlongOpticalAxis) {
   }
 }
 
+// The checkerboard world with one flat-roofed building, 4 m x 4 m and 6 m
+// tall, centred 5 m north of the origin.
+class BuildingWorld : public test::CheckerWorld {
+ public:
+  BuildingWorld() : CheckerWorld(9, 7, 1.0) {}
+  std::vector<terrain::GroundObject> objects(const terrain::GroundSquare& sq) const override {
+    terrain::GroundObject building;
+    building.kind = terrain::GroundObject::Kind::kBuilding;
+    building.north_m = 5.0;
+    building.height_m = 6.0;
+    building.half_length_m = building.half_width_m = 2.0;
+    building.rgb = {250, 250, 250};
+    const bool inside = building.north_m >= sq.north_min_m &&
+                        building.north_m < sq.north_min_m + sq.size_m &&
+                        building.east_m >= sq.east_min_m &&
+                        building.east_m < sq.east_min_m + sq.size_m;
+    return inside ? std::vector<terrain::GroundObject>{building}
+                  : std::vector<terrain::GroundObject>{};
+  }
+};
+
+// With objects_3d, a building stands at its height: from 30 m straight above
+// the origin, the depth where its roof projects is 30 - 6 = 24 m, where a
+// point of its south wall 3 m up projects 27 m, where the ground 9 m north
+// projects (the ray clears the roof's north edge at 6.7 m) 30 m; and the
+// ground 7.5 m north is hidden: its ray meets the roof at 6 m north, 24 m
+// deep. Without objects_3d every one of those pixels sees the ground.
+TEST(CameraRenderer, ABuildingStandsAtItsHeight) {
+  for (const bool objects : {true, false}) {
+    HeadlessGlContext context;
+    auto world = std::make_shared<BuildingWorld>();
+    terrain::TileParams tile_params;
+    tile_params.texture_px = 256;
+    auto tiles = std::make_shared<terrain::TileTree>(world, tile_params);
+    TerrainRendererParams renderer_params;
+    renderer_params.objects_3d = objects;
+    renderer_params.objects_max_texel_m = 100.0;
+    TerrainRenderer terrain(tiles, renderer_params);
+    CameraRenderer camera(terrain, testCamera());
+    const Eigen::Isometry3d T_world_cam = downCameraPose({0.0, 0.0, -30.0}, 0.0, 0.0, 0.0);
+    const RenderedImage frame = camera.render(T_world_cam, 0, true);
+    const CameraIntrinsics& k = camera.intrinsics();
+    const auto depthAt = [&](const Eigen::Vector3d& p_world) {
+      const Eigen::Vector3d p = T_world_cam.inverse() * p_world;
+      const int u = static_cast<int>(std::lround(k.fx * p.x() / p.z() + k.cx));
+      const int v = static_cast<int>(std::lround(k.fy * p.y() / p.z() + k.cy));
+      return static_cast<double>(frame.depth_m.at<float>(v, u));
+    };
+    const double roof = depthAt({5.5, 0.5, -6.0});
+    const double wall = depthAt({3.0, 0.5, -3.0});
+    const double ground_beyond = depthAt({9.0, 0.0, 0.0});
+    const double ground_hidden = depthAt({7.5, 0.0, 0.0});
+    std::printf("objects %s: depth roof %.3f, wall %.3f, ground beyond %.3f, hidden %.3f m\n",
+                objects ? "on" : "off", roof, wall, ground_beyond, ground_hidden);
+    EXPECT_NEAR(ground_beyond, 30.0, 0.05);
+    if (objects) {
+      EXPECT_NEAR(roof, 24.0, 0.05);
+      EXPECT_NEAR(wall, 27.0, 0.3);  // a pixel spans 0.1 m of wall at this slant
+      EXPECT_NEAR(ground_hidden, 24.0, 0.05);
+    } else {
+      EXPECT_NEAR(ground_hidden, 30.0, 0.05);
+      EXPECT_GT(roof, 29.9);
+    }
+  }
+}
+
 // A concentric ground target appears where it lies, with all its rings: along the row
 // through its centre, 5 rings give 10 dark runs, and the dark pixels centre on its projection.
 TEST(CameraRenderer, ConcentricTargetIsDrawnWithItsRings) {

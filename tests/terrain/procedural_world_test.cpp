@@ -399,4 +399,91 @@ TEST(ProceduralWorld, TextureStrengthScalesTheTextureInsideTheFields) {
 }
 
 }  // namespace
+// The objects standing on the ground: the four quarters of a square hold
+// exactly the objects of the whole, each once and inside its quarter; trees
+// have the heights the imagery's shadows were cast with (broadleaf 10-18 m,
+// conifers 14-22 m) and crowns of 3.2-5.2 m and 1.8-2.9 m times 0.9-1.3
+// (hedgerow and field-edge trees); buildings are 6-9 m tall; every object
+// stands on the ground below its centre.
+TEST(ProceduralWorld, ObjectsStandOnTheGroundOncePerSquare) {
+  const ProceduralWorld& world = defaultWorld();
+  // 1 km north-east of the origin: forest, fields, hedges and farmsteads.
+  const GroundSquare whole{500.0, 500.0, 1000.0};
+  const std::vector<GroundObject> all = world.objects(whole);
+  std::size_t in_quarters = 0;
+  int trees = 0, buildings = 0;
+  for (int q = 0; q < 4; ++q) {
+    const GroundSquare quarter{500.0 + 500.0 * (q / 2), 500.0 + 500.0 * (q % 2), 500.0};
+    const std::vector<GroundObject> part = world.objects(quarter);
+    in_quarters += part.size();
+    for (const GroundObject& o : part) {
+      EXPECT_GE(o.north_m, quarter.north_min_m);
+      EXPECT_LT(o.north_m, quarter.north_min_m + quarter.size_m);
+      EXPECT_GE(o.east_m, quarter.east_min_m);
+      EXPECT_LT(o.east_m, quarter.east_min_m + quarter.size_m);
+      EXPECT_DOUBLE_EQ(o.base_up_m, world.groundUp_m(o.north_m, o.east_m));
+      switch (o.kind) {
+        case GroundObject::Kind::kBroadleaf:
+          ++trees;
+          EXPECT_GE(o.height_m, 10.0);
+          EXPECT_LE(o.height_m, 18.0);
+          EXPECT_GE(o.half_length_m, 3.2 * 0.9);
+          EXPECT_LE(o.half_length_m, 5.2 * 1.3);
+          break;
+        case GroundObject::Kind::kConifer:
+          ++trees;
+          EXPECT_GE(o.height_m, 14.0);
+          EXPECT_LE(o.height_m, 22.0);
+          EXPECT_GE(o.half_length_m, 1.8 * 0.9);
+          EXPECT_LE(o.half_length_m, 2.9 * 1.3);
+          break;
+        case GroundObject::Kind::kBuilding:
+          ++buildings;
+          EXPECT_GE(o.height_m, 6.0);
+          EXPECT_LE(o.height_m, 9.0);
+          EXPECT_GT(o.half_length_m, 0.0);
+          break;
+      }
+    }
+  }
+  EXPECT_EQ(in_quarters, all.size());
+  std::printf("1 km square: %d trees, %d buildings\n", trees, buildings);
+  EXPECT_GT(trees, 100);
+  EXPECT_GT(buildings, 0);
+  // The same square asked again gives the same objects in the same order.
+  const std::vector<GroundObject> again = world.objects(whole);
+  ASSERT_EQ(again.size(), all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(again[i].north_m, all[i].north_m);
+    EXPECT_EQ(again[i].height_m, all[i].height_m);
+  }
+}
+
+// The imagery beneath the objects leaves out crowns and roofs and keeps the
+// rest: over open field away from every object it is the imagery itself,
+// and over the square as a whole it differs where the tops were.
+TEST(ProceduralWorld, ImageryBeneathObjectsLeavesOutTheirTops) {
+  const ProceduralWorld& world = defaultWorld();
+  const GroundSquare square{-200.0, -200.0, 400.0};
+  cv::Mat with_tops, beneath;
+  world.imagery(square, 800, with_tops);
+  world.imageryBeneathObjects(square, 800, beneath);
+  cv::Mat differs;
+  cv::absdiff(with_tops, beneath, differs);
+  cv::cvtColor(differs, differs, cv::COLOR_RGB2GRAY);
+  const int changed = cv::countNonZero(differs > 2);
+  EXPECT_GT(changed, 0);
+  // Every changed pixel lies within a crown's or roof's reach of an object.
+  const std::vector<GroundObject> objects = world.objects(GroundSquare{-250.0, -250.0, 500.0});
+  cv::Mat near_object = cv::Mat::zeros(800, 800, CV_8U);
+  for (const GroundObject& o : objects) {
+    const double reach_m = std::hypot(o.half_length_m, o.half_width_m) * 1.2 + 1.0;
+    const cv::Point centre(static_cast<int>((o.east_m - square.east_min_m) * 2.0),
+                           static_cast<int>((square.north_min_m + square.size_m - o.north_m) * 2.0));
+    cv::circle(near_object, centre, static_cast<int>(reach_m * 2.0) + 1, 255, cv::FILLED);
+  }
+  cv::Mat far_and_changed = (differs > 2) & (near_object == 0);
+  EXPECT_EQ(cv::countNonZero(far_and_changed), 0);
+}
+
 }  // namespace nadir::terrain

@@ -354,6 +354,30 @@ TEST(BundleAdjustmentTest, RotationPriorConstrainsAnUnderdeterminedCamera) {
       0.2);
 }
 
+// A prior's heading sigma: camera 1, free and seen by nothing, between two
+// priors from the fixed world-axes camera 0: one turned 2 deg about north
+// and 2 deg about down with sigma 0.5 deg (tilt) and 3 deg (heading), one at
+// no turn with sigma 1 deg. By hand (weighted means, small angles): about
+// north (2/0.5^2) / (1/0.5^2 + 1/1^2) = 1.6 deg, about down (2/3^2) /
+// (1/3^2 + 1/1^2) = 0.2 deg, about east 0 to second order (the two turns'
+// product, 2 x 2 deg in radians over 2: 0.035 deg).
+TEST(BundleAdjustmentTest, ARotationPriorWeighsItsHeadingByItsOwnSigma) {
+  BaProblem problem;
+  problem.cameras = {{Eigen::Isometry3d::Identity(), true}, {Eigen::Isometry3d::Identity(), false}};
+  const Eigen::Vector3d turn_rad(2.0 * kDeg, 0.0, 2.0 * kDeg);
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(turn_rad.norm(), turn_rad.normalized()));
+  problem.rotation_priors.push_back({0, 1, turned, 0.5 * kDeg, 3.0 * kDeg});
+  problem.rotation_priors.push_back({0, 1, Eigen::Quaterniond::Identity(), 1.0 * kDeg});
+  bundleAdjust(problem, {});
+  const Eigen::AngleAxisd estimated(problem.cameras[1].T_world_cam.rotation());
+  const Eigen::Vector3d rotation_deg = estimated.angle() * estimated.axis() / kDeg;
+  std::printf("rotation vector %.4f %.4f %.4f deg\n", rotation_deg.x(), rotation_deg.y(),
+              rotation_deg.z());
+  EXPECT_NEAR(rotation_deg.x(), 1.6, 0.01);
+  EXPECT_NEAR(rotation_deg.y(), 0.0, 0.035);
+  EXPECT_NEAR(rotation_deg.z(), 0.2, 0.01);
+}
+
 // Bad input is refused.
 TEST(BundleAdjustmentTest, RejectsBadIndicesAndSigmas) {
   Scene scene = makeScene({});
