@@ -60,9 +60,9 @@ void main() {
 using Vertices = std::vector<float>;
 
 void addVertex(Vertices& v, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
-  v.insert(v.end(), {static_cast<float>(p.x()), static_cast<float>(p.y()),
-                     static_cast<float>(p.z()), static_cast<float>(n.x()),
-                     static_cast<float>(n.y()), static_cast<float>(n.z())});
+  v.insert(v.end(),
+           {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()),
+            static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())});
 }
 
 // A flat triangle, counter-clockwise seen from outside.
@@ -93,8 +93,8 @@ double sameAreaRadius(int n) {
 // An upright prism (a trunk) of radius r from z0 to z1.
 void addPrism(Vertices& v, int segments, double r, double z0, double z1) {
   for (int i = 0; i < segments; ++i) {
-    addQuad(v, ring(i, segments, r, z0), ring(i + 1, segments, r, z0),
-            ring(i + 1, segments, r, z1), ring(i, segments, r, z1));
+    addQuad(v, ring(i, segments, r, z0), ring(i + 1, segments, r, z0), ring(i + 1, segments, r, z1),
+            ring(i, segments, r, z1));
   }
 }
 
@@ -108,16 +108,16 @@ void addCrown(Vertices& v, int segments, int stacks, double z0, double z1) {
     const double t = 2.0 * std::numbers::pi * i / segments;
     const Eigen::Vector3d unit(std::sin(phi) * std::cos(t), std::sin(phi) * std::sin(t),
                                std::cos(phi));
-    return std::pair{Eigen::Vector3d(across * unit.x(), across * unit.y(), centre + half * unit.z()),
-                     Eigen::Vector3d(unit.x(), unit.y(), unit.z() / half)};
+    return std::pair{
+        Eigen::Vector3d(across * unit.x(), across * unit.y(), centre + half * unit.z()),
+        Eigen::Vector3d(unit.x(), unit.y(), unit.z() / half)};
   };
   const auto emit = [&](const std::pair<Eigen::Vector3d, Eigen::Vector3d>& p) {
     addVertex(v, p.first, p.second.normalized());
   };
   for (int k = 0; k < stacks; ++k) {
     for (int i = 0; i < segments; ++i) {
-      const auto a = point(i, k), b = point(i, k + 1), c = point(i + 1, k + 1),
-                 d = point(i + 1, k);
+      const auto a = point(i, k), b = point(i, k + 1), c = point(i + 1, k + 1), d = point(i + 1, k);
       // At the poles a quad is one triangle (a = d at the top, b = c at the bottom).
       if (k + 1 < stacks) {
         emit(a), emit(b), emit(c);
@@ -214,15 +214,15 @@ ObjectInstances::ObjectInstances(const std::vector<terrain::GroundObject>& objec
   for (const terrain::GroundObject& o : objects) {
     std::vector<float>& data = by_mesh[static_cast<std::size_t>(meshIndex(o))];
     const bool tree = o.kind != terrain::GroundObject::Kind::kBuilding;
-    data.insert(data.end(),
-                {static_cast<float>(o.north_m - origin_ned.x()),
-                 static_cast<float>(o.east_m - origin_ned.y()),
-                 static_cast<float>(-o.base_up_m - origin_ned.z()),
-                 static_cast<float>(o.half_length_m),
-                 static_cast<float>(tree ? o.half_length_m : o.half_width_m),
-                 static_cast<float>(o.height_m), static_cast<float>(std::cos(o.heading_rad)),
-                 static_cast<float>(std::sin(o.heading_rad)), o.rgb[0] / 255.0f,
-                 o.rgb[1] / 255.0f, o.rgb[2] / 255.0f});
+    data.insert(
+        data.end(),
+        {static_cast<float>(o.north_m - origin_ned.x()),
+         static_cast<float>(o.east_m - origin_ned.y()),
+         static_cast<float>(-o.base_up_m - origin_ned.z()), static_cast<float>(o.half_length_m),
+         static_cast<float>(tree ? o.half_length_m : o.half_width_m),
+         static_cast<float>(o.height_m), static_cast<float>(std::cos(o.heading_rad)),
+         static_cast<float>(std::sin(o.heading_rad)), o.rgb[0] / 255.0f, o.rgb[1] / 255.0f,
+         o.rgb[2] / 255.0f});
   }
   std::vector<float> all;
   for (std::size_t k = 0; k < by_mesh.size(); ++k) {

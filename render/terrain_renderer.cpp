@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "render/detail_texture.h"
-#include "render/ground_objects.h"
 #include "render/gl.h"
+#include "render/ground_objects.h"
 
 namespace nadir::render {
 namespace {
@@ -417,8 +417,8 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
   glBindVertexArray(0);
 
   // Where the objects stand up, the imagery leaves out their tops.
-  const bool objects =
-      objects_ && geometry->square.size_m / tiles_->params().texture_px <= params_.objects_max_texel_m;
+  const bool objects = objects_ && geometry->square.size_m / tiles_->params().texture_px <=
+                                       params_.objects_max_texel_m;
   const cv::Mat rgb = tiles_->imagery(id, objects);
   // Nearest mip level, bilinear within it: cheaper than trilinear on llvmpipe,
   // and the tile choice keeps the level near 0 (a texel about a pixel).

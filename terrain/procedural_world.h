@@ -103,8 +103,7 @@ class ProceduralWorld final : public World {
   // split into 256-pixel blocks rendered in parallel. Throws
   // std::invalid_argument for size_px < 1 or a non-finite or empty square.
   void imagery(const GroundSquare& square, int size_px, cv::Mat& rgb) const override;
-  void imageryBeneathObjects(const GroundSquare& square, int size_px,
-                             cv::Mat& rgb) const override;
+  void imageryBeneathObjects(const GroundSquare& square, int size_px, cv::Mat& rgb) const override;
   // params().imagery_resolution_m: the finest detail is drawn for it.
   double imageryResolution_m() const override;
   // 4 m: the height field's finest octaves are about 12 m long.

@@ -71,8 +71,7 @@ class World {
   // The same with the tops of objects() (crowns, roofs) left out and their
   // shadows kept: the ground beneath them, for a renderer that draws them in
   // 3D. By default imagery().
-  virtual void imageryBeneathObjects(const GroundSquare& square, int size_px,
-                                     cv::Mat& rgb) const {
+  virtual void imageryBeneathObjects(const GroundSquare& square, int size_px, cv::Mat& rgb) const {
     imagery(square, size_px, rgb);
   }
 
@@ -92,9 +91,7 @@ class World {
   // Unit vector towards the sun in the world frame (NED): the light objects()
   // are drawn under, the one imagery() was shaded with. By default the
   // procedural world's default sun (azimuth 150 deg, elevation 45 deg).
-  virtual std::array<double, 3> sunDirectionNed() const {
-    return sunDirectionNed(150.0, 45.0);
-  }
+  virtual std::array<double, 3> sunDirectionNed() const { return sunDirectionNed(150.0, 45.0); }
   static std::array<double, 3> sunDirectionNed(double azimuth_deg, double elevation_deg) {
     const double az = azimuth_deg * 3.14159265358979323846 / 180.0;
     const double el = elevation_deg * 3.14159265358979323846 / 180.0;

@@ -22,6 +22,8 @@ struct VoFrameInput {
   std::optional<double> range_m;
   Eigen::Vector3d range_ray_cam = Eigen::Vector3d::UnitZ();
   std::optional<Eigen::Quaterniond> q_world_body_prior;  // optional attitude prior
+  // A rolling shutter's readout, top row to bottom row, s (0: a global shutter).
+  double readout_s = 0.0;
 };
 
 enum class VoStatus { kInitializing, kTracking, kLost };

@@ -9,7 +9,8 @@ namespace nadir::nodes {
 
 VoFrameSource::VoFrameSource(core::Bus& bus, const VoFrameSourceChannels& channels,
                              std::function<void(const Eigen::Isometry3d&)> on_start)
-    : on_start_(std::move(on_start)), inputs_(bus, channels.range_channel, channels.attitude_channel) {
+    : on_start_(std::move(on_start)),
+      inputs_(bus, channels.range_channel, channels.attitude_channel) {
   subscriptions_.push_back(
       msg::subscribe<msg::Pose>(bus, channels.truth_channel, [this](const msg::Pose& pose) {
         if (started_) return;
@@ -65,6 +66,7 @@ std::variant<vo::VoFrameInput, std::string> VoFrameSource::frame(const msg::Imag
   input.gray = gray;
   input.K = K;
   input.R_body_cam = info_->q_body_cam.toRotationMatrix();
+  input.readout_s = info_->readout_s;
   // The rangefinder looks along the body's down axis.
   input.range_m = inputs_.validRange_m();
   input.range_ray_cam = input.R_body_cam.transpose() * Eigen::Vector3d::UnitZ();

@@ -7,6 +7,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "nodes/common/rolling_shutter.h"
 #include "nodes/vo_direct/camera_model.h"
 #include "nodes/vo_direct/lie.h"
 
@@ -58,6 +59,8 @@ void DirectVoParams::visit(core::ParamVisitor& v) {
           {.doc = "lost when the camera moved faster than this since the last good frame, m/s",
            .min = 0.1,
            .max = 1e6});
+  v.field("rolling_shutter", &rolling_shutter,
+          {.doc = "rectify a rolling-shutter camera's frames with the motion model's velocity"});
   v.field("lost_frames_before_reset", &lost_frames_before_reset,
           {.doc = "lost frames in a row before the map is made again", .min = 1, .max = 1000});
   v.field("range_window_px", &range_window_px,
@@ -150,6 +153,20 @@ void DirectVo::dropMap() {
   keyframe_points_.clear();
 }
 
+cv::Mat DirectVo::globalShutterImage(const VoFrameInput& in) const {
+  if (!params_.rolling_shutter || !(in.readout_s > 0.0) || keyframes_.empty() ||
+      !(delta_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
+    return in.gray;
+  // delta_ maps the last frame's camera coordinates to the frame's:
+  // R_world_cam(k) = R_world_cam(k-1) Exp(omega dt) gives Exp(omega dt) =
+  // delta^T, and the camera's centre moved by -R^T t in the last frame's axes.
+  const Eigen::AngleAxisd turn(delta_.linear().transpose());
+  CameraTwist twist;
+  twist.omega_cam_rps = turn.angle() * turn.axis() / delta_period_s_;
+  twist.v_cam_mps = -(delta_.linear().transpose() * delta_.translation()) / delta_period_s_;
+  return rectifyRollingShutter(in.gray, in.K, in.readout_s, twist, *in.range_m);
+}
+
 Eigen::Isometry3d DirectVo::predictCamWorld(int steps) const {
   return power(delta_, steps) * T_cam_world_last_;
 }
@@ -168,6 +185,8 @@ DirectVoOutput DirectVo::output(VoStatus status, const Eigen::Isometry3d& T_cam_
 
 void DirectVo::acceptPose(const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine) {
   delta_ = orthonormalized(T_cam_world * T_cam_world_last_.inverse());
+  if (frame_time_s_ > last_good_time_s_)
+    delta_period_s_ = (frame_time_s_ - last_good_time_s_) / std::max(frames_since_good_, 1);
   if (frames_since_good_ > 1) {
     // After lost frames the motion is spread over them.
     const Eigen::Isometry3d total = T_cam_world * T_cam_world_last_.inverse();
@@ -196,8 +215,9 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
   frame_time_s_ = static_cast<double>(in.utime) * 1e-6;
 
   auto t0 = Clock::now();
+  const cv::Mat gray = globalShutterImage(in);
   auto pyramid =
-      std::make_unique<ImagePyramid>(in.gray, params_.pyramid_levels, params_.tracker.finest_level);
+      std::make_unique<ImagePyramid>(gray, params_.pyramid_levels, params_.tracker.finest_level);
   timing_.pyramid_s += secondsSince(t0);
 
   if (pending_start_ || pending_in_place_) {

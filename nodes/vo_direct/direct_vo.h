@@ -71,6 +71,10 @@ struct DirectVoParams {
   // this speed allows is lost: no vehicle nadir flies is faster, and a pose
   // fitted to faint texture can leap by kilometres.
   double lost_speed_mps = 150.0;
+  // Rectify the frames of a rolling-shutter camera (VoFrameInput::readout_s)
+  // to a global shutter at their stamp, with the motion model's velocity
+  // (rolling_shutter.h), before they are tracked.
+  bool rolling_shutter = true;
   // Lost frames in a row before the map is dropped and made again.
   int lost_frames_before_reset = 3;
   // Points of a key-frame within this of the rangefinder ray's image carry
@@ -146,6 +150,8 @@ class DirectVo {
                 const Eigen::Isometry3d& T_cam_world, const AffineBrightness& affine);
   TrackResult track(const ImagePyramid& pyramid);
   bool isLost(const TrackResult& result) const;
+  // The frame as a global shutter would see it (rolling_shutter).
+  cv::Mat globalShutterImage(const VoFrameInput& in) const;
   // The frame's pose when it is lost: the motion model's.
   DirectVoOutput lostFrame(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                            int points);
@@ -183,6 +189,7 @@ class DirectVo {
   Eigen::Isometry3d T_cam_world_last_ = Eigen::Isometry3d::Identity();
   // Time of the last good frame and of the frame being processed, s.
   double last_good_time_s_ = 0.0;
+  double delta_period_s_ = 0.0;  // the time delta_ spans
   double frame_time_s_ = 0.0;
   Eigen::Isometry3d delta_ = Eigen::Isometry3d::Identity();
   AffineBrightness affine_last_;

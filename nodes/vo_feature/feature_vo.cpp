@@ -10,6 +10,8 @@
 #include <set>
 #include <unordered_map>
 
+#include "nodes/common/rolling_shutter.h"
+
 namespace nadir::vo {
 namespace {
 
@@ -95,6 +97,8 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
           {.doc = "standard deviation of the attitude prior's heading, deg",
            .min = 1e-3,
            .max = 180.0});
+  v.field("rolling_shutter", &rolling_shutter,
+          {.doc = "rectify a rolling-shutter camera's frames with the motion model's velocity"});
   v.field("reinit_from_range", &reinit_from_range,
           {.doc = "after a loss, start the new map from the rangefinder's ground plane at once"});
   v.field("scale_tolerance", &scale_tolerance,
@@ -228,6 +232,19 @@ int FeatureVo::numMapPoints() const {
       std::count_if(points_.begin(), points_.end(), [](const MapPoint& p) { return !p.bad; }));
 }
 
+cv::Mat FeatureVo::globalShutterImage(const VoFrameInput& in) const {
+  if (!params_.rolling_shutter || !(in.readout_s > 0.0) || status_ != VoStatus::kTracking ||
+      !(frame_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
+    return in.gray;
+  // T_world_cam(k) = T_world_cam(k-1) T_delta_: the rotation is Exp(omega dt)
+  // and the translation v dt, in the last frame's camera axes.
+  const Eigen::AngleAxisd turn(T_delta_.linear());
+  CameraTwist twist;
+  twist.omega_cam_rps = turn.angle() * turn.axis() / frame_period_s_;
+  twist.v_cam_mps = T_delta_.translation() / frame_period_s_;
+  return rectifyRollingShutter(in.gray, in.K, in.readout_s, twist, *in.range_m);
+}
+
 Eigen::Isometry3d FeatureVo::predict(int steps) const {
   Eigen::Isometry3d T = T_world_cam_last_;
   for (int i = 0; i < steps; ++i) T = T * T_delta_;
@@ -268,9 +285,12 @@ VoFrameOutput FeatureVo::processFrame(const VoFrameInput& in) {
   ++timing_.frames;
   collectBackgroundBa(false);
   auto stage_start = Clock::now();
+  if (last_utime_ != 0 && in.utime > last_utime_)
+    frame_period_s_ = static_cast<double>(in.utime - last_utime_) * 1e-6;
+  last_utime_ = in.utime;
   Frame cur;
   cur.id = frame_index_;
-  cur.features = extractOrb(in.gray, params_.features);
+  cur.features = extractOrb(globalShutterImage(in), params_.features);
   cur.point_of_feature.assign(cur.features.keypoints.size(), -1);
   timing_.extract_s += secondsSince(stage_start);
   last_features_.clear();

@@ -72,6 +72,10 @@ struct FeatureVoParams {
   // rangefinder sees (every feature's ray met with the level plane through the
   // range's ground point), not by two-view initialisation.
   bool reinit_from_range = true;
+  // Rectify the frames of a rolling-shutter camera (VoFrameInput::readout_s)
+  // to a global shutter at their stamp, with the motion model's velocity,
+  // before features are found (nodes/common/rolling_shutter.h).
+  bool rolling_shutter = true;
   // Scale upkeep: correct when |range ratio - 1| exceeds this, by this share.
   double scale_tolerance = 0.002;
   double scale_gain = 0.5;
@@ -169,6 +173,8 @@ class FeatureVo {
                                  const VoFrameInput& in) const;
   std::optional<double> mapRange(const Frame& kf, const VoFrameInput& in) const;
   Eigen::Isometry3d predict(int steps) const;
+  // The frame as a global shutter would see it (rolling_shutter).
+  cv::Mat globalShutterImage(const VoFrameInput& in) const;
 
   FeatureVoParams params_;
   Eigen::Isometry3d T_world_body_start_ = Eigen::Isometry3d::Identity();
@@ -193,6 +199,9 @@ class FeatureVo {
   Eigen::Isometry3d T_world_cam_last_ = Eigen::Isometry3d::Identity();
   // Per-frame motion: T_world_cam(k+1) = T_world_cam(k) * T_delta_.
   Eigen::Isometry3d T_delta_ = Eigen::Isometry3d::Identity();
+  // The time between the last two frames, s (0: not known yet).
+  double frame_period_s_ = 0.0;
+  std::int64_t last_utime_ = 0;
   int frames_since_good_ = 1;
   int lost_count_ = 0;
   // The map was seeded from the range and no frame has tracked it yet.

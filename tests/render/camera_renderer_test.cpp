@@ -190,10 +190,9 @@ class BuildingWorld : public test::CheckerWorld {
     building.height_m = 6.0;
     building.half_length_m = building.half_width_m = 2.0;
     building.rgb = {250, 250, 250};
-    const bool inside = building.north_m >= sq.north_min_m &&
-                        building.north_m < sq.north_min_m + sq.size_m &&
-                        building.east_m >= sq.east_min_m &&
-                        building.east_m < sq.east_min_m + sq.size_m;
+    const bool inside =
+        building.north_m >= sq.north_min_m && building.north_m < sq.north_min_m + sq.size_m &&
+        building.east_m >= sq.east_min_m && building.east_m < sq.east_min_m + sq.size_m;
     return inside ? std::vector<terrain::GroundObject>{building}
                   : std::vector<terrain::GroundObject>{};
   }

@@ -478,8 +478,9 @@ TEST(ProceduralWorld, ImageryBeneathObjectsLeavesOutTheirTops) {
   cv::Mat near_object = cv::Mat::zeros(800, 800, CV_8U);
   for (const GroundObject& o : objects) {
     const double reach_m = std::hypot(o.half_length_m, o.half_width_m) * 1.2 + 1.0;
-    const cv::Point centre(static_cast<int>((o.east_m - square.east_min_m) * 2.0),
-                           static_cast<int>((square.north_min_m + square.size_m - o.north_m) * 2.0));
+    const cv::Point centre(
+        static_cast<int>((o.east_m - square.east_min_m) * 2.0),
+        static_cast<int>((square.north_min_m + square.size_m - o.north_m) * 2.0));
     cv::circle(near_object, centre, static_cast<int>(reach_m * 2.0) + 1, 255, cv::FILLED);
   }
   cv::Mat far_and_changed = (differs > 2) & (near_object == 0);
