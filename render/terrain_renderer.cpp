@@ -139,6 +139,19 @@ Eigen::Matrix4d clipFromCamera(const CameraIntrinsics& k, double near_m, double 
   return P;
 }
 
+// Clip space from a tile's frame (its corner origin_ned, world axes): camera-
+// relative in double, then float, for full precision near the camera.
+Eigen::Matrix4f clipFromTile(const Eigen::Matrix4d& clip_from_camera,
+                             const Eigen::Isometry3d& T_world_cam,
+                             const terrain::GroundSquare& square) {
+  const Eigen::Matrix3d R_cam_world = T_world_cam.rotation().transpose();
+  const Eigen::Vector3d origin_ned(square.north_min_m, square.east_min_m, 0.0);
+  Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
+  camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
+  camera_from_local.topRightCorner<3, 1>() = R_cam_world * (origin_ned - T_world_cam.translation());
+  return (clip_from_camera * camera_from_local).cast<float>();
+}
+
 }  // namespace
 
 struct TerrainRenderer::GpuTile {
@@ -322,24 +335,19 @@ void TerrainRenderer::drawTargets(const DrawView& view, const Eigen::Matrix4d& c
 }
 
 void TerrainRenderer::drawObjects(const DrawView& view, const Eigen::Matrix4d& clip_from_camera,
-                                  const std::vector<terrain::TileId>& visible, DrawStats& stats) {
-  const Eigen::Vector3d camera_ned = view.T_world_cam.translation();
-  const Eigen::Matrix3d R_cam_world = view.T_world_cam.rotation().transpose();
+                                  const std::vector<terrain::TileId>& visible,
+                                  const std::vector<double>& nearest_m, DrawStats& stats) {
   const double focal_px = std::max(view.intrinsics.fx, view.intrinsics.fy);
   objects_->begin(tiles_->world().sunDirectionNed(), view.gain, view.gray);
-  for (const terrain::TileId& id : visible) {
-    const auto found = gpu_tiles_.find(id.key());
+  for (std::size_t i = 0; i < visible.size(); ++i) {
+    const auto found = gpu_tiles_.find(visible[i].key());
     if (found == gpu_tiles_.end() || !found->second->objects) continue;
     const GpuTile& tile = *found->second;
     // Fine meshes while a 4 m crown at the tile's nearest point spans 16 px or more.
-    const double nearest_m = std::max(tiles_->geometry(id)->distanceFrom_m(camera_ned), 1.0);
-    const ObjectDetail detail =
-        4.0 * focal_px / nearest_m >= 16.0 ? ObjectDetail::kFine : ObjectDetail::kCoarse;
-    const Eigen::Vector3d origin_ned(tile.square.north_min_m, tile.square.east_min_m, 0.0);
-    Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
-    camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
-    camera_from_local.topRightCorner<3, 1>() = R_cam_world * (origin_ned - camera_ned);
-    const Eigen::Matrix4f clip = (clip_from_camera * camera_from_local).cast<float>();
+    const ObjectDetail detail = 4.0 * focal_px / std::max(nearest_m[i], 1.0) >= 16.0
+                                    ? ObjectDetail::kFine
+                                    : ObjectDetail::kCoarse;
+    const Eigen::Matrix4f clip = clipFromTile(clip_from_camera, view.T_world_cam, tile.square);
     const ObjectDrawStats drawn = objects_->draw(*tile.objects, clip.data(), detail);
     stats.objects += drawn.objects;
     stats.triangles += drawn.triangles;
@@ -470,16 +478,17 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
   const Eigen::Vector3d camera_ned = view.T_world_cam.translation();
   const double focal_px = std::max(view.intrinsics.fx, view.intrinsics.fy);
   std::vector<terrain::TileId> plain, detailed;
+  std::vector<double> nearest_m;  // per visible tile
+  nearest_m.reserve(visible.size());
   for (const terrain::TileId& id : visible) {
     const auto geometry = tiles_->geometry(id);
     const terrain::GroundSquare& sq = geometry->square;
-    const double nearest_m = geometry->distanceFrom_m(camera_ned);
+    nearest_m.push_back(geometry->distanceFrom_m(camera_ned));
     const double texel_m = sq.size_m / tiles_->params().texture_px;
-    (view.ground_detail && texel_m > nearest_m / focal_px ? detailed : plain).push_back(id);
+    (view.ground_detail && texel_m > nearest_m.back() / focal_px ? detailed : plain).push_back(id);
   }
 
   const Eigen::Matrix4d P = clipFromCamera(view.intrinsics, view.near_m, view.far_m);
-  const Eigen::Matrix3d R_cam_world = view.T_world_cam.rotation().transpose();
   for (const auto& [program, ids] :
        {std::pair{program_plain_, &plain}, {program_detail_, &detailed}}) {
     if (ids->empty()) continue;
@@ -507,12 +516,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
                 static_cast<float>(repeat_2_m));
     for (const terrain::TileId& id : *ids) {
       GpuTile& tile = acquire(id, stats.tiles_uploaded);
-      // Camera-relative in double, then float: full precision near the camera.
-      const Eigen::Vector3d origin_ned(tile.square.north_min_m, tile.square.east_min_m, 0.0);
-      Eigen::Matrix4d camera_from_local = Eigen::Matrix4d::Identity();
-      camera_from_local.topLeftCorner<3, 3>() = R_cam_world;
-      camera_from_local.topRightCorner<3, 1>() = R_cam_world * (origin_ned - camera_ned);
-      const Eigen::Matrix4f clip = (P * camera_from_local).cast<float>();
+      const Eigen::Matrix4f clip = clipFromTile(P, view.T_world_cam, tile.square);
       glUniformMatrix4fv(clip_from_local, 1, GL_FALSE, clip.data());
       glUniform1f(size_m, static_cast<float>(tile.square.size_m));
       glUniform1f(texel_m, static_cast<float>(tile.square.size_m / tiles_->params().texture_px));
@@ -531,7 +535,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
     }
   }
   glBindVertexArray(0);
-  if (objects_) drawObjects(view, P, visible, stats);
+  if (objects_) drawObjects(view, P, visible, nearest_m, stats);
   drawTargets(view, P);
   evictBeyondBudget(visible);
   checkGl("drawing the terrain");

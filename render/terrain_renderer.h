@@ -91,8 +91,10 @@ class TerrainRenderer {
   void drawTargets(const DrawView& view, const Eigen::Matrix4d& clip_from_camera);
   unsigned int program_target_ = 0;
   std::vector<std::unique_ptr<GpuTarget>> targets_;
+  // nearest_m: each visible tile's distance from the camera.
   void drawObjects(const DrawView& view, const Eigen::Matrix4d& clip_from_camera,
-                   const std::vector<terrain::TileId>& visible, DrawStats& stats);
+                   const std::vector<terrain::TileId>& visible,
+                   const std::vector<double>& nearest_m, DrawStats& stats);
   std::unique_ptr<GroundObjectRenderer> objects_;
   std::unordered_map<std::uint64_t, std::unique_ptr<GpuTile>> gpu_tiles_;
   std::list<std::uint64_t> lru_;

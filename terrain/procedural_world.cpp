@@ -155,11 +155,10 @@ std::vector<GroundObject> ProceduralWorld::objects(const GroundSquare& square) c
   };
   // Internally x is east and y north.
   const procedural::WorldBox box{e0, n0, e0 + size, n0 + size};
+  // As the imagery writes its pixels (procedural/shading.cpp).
   const auto colour = [](const procedural::Rgb& c) {
-    const auto channel = [](double v) {
-      return static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
-    };
-    return std::array<std::uint8_t, 3>{channel(c.r), channel(c.g), channel(c.b)};
+    return std::array<std::uint8_t, 3>{cv::saturate_cast<uchar>(c.r), cv::saturate_cast<uchar>(c.g),
+                                       cv::saturate_cast<uchar>(c.b)};
   };
   std::vector<GroundObject> out;
   std::vector<procedural::Tree> trees;

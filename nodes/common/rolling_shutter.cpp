@@ -20,6 +20,16 @@ Eigen::Matrix3d rotationExp(const Eigen::Vector3d& w) {
 
 }  // namespace
 
+CameraTwist cameraTwist(const Eigen::Isometry3d& T_prev_cur, double dt_s) {
+  // T_world_cam(k) = T_world_cam(k-1) T_prev_cur: the rotation is Exp(omega dt)
+  // and the translation v dt, in the previous frame's camera axes.
+  const Eigen::AngleAxisd turn(T_prev_cur.linear());
+  CameraTwist twist;
+  twist.omega_cam_rps = turn.angle() * turn.axis() / dt_s;
+  twist.v_cam_mps = T_prev_cur.translation() / dt_s;
+  return twist;
+}
+
 cv::Mat rectifyRollingShutter(const cv::Mat& gray, const cv::Matx33d& K, double readout_s,
                               const CameraTwist& twist, double depth_m) {
   if (gray.empty() || gray.type() != CV_8UC1)
@@ -59,16 +69,20 @@ cv::Mat rectifyRollingShutter(const cv::Mat& gray, const cv::Matx33d& K, double 
     const float fr = static_cast<float>(r - gr * kGridPx) / kGridPx;
     float* mx = map_x.ptr<float>(r);
     float* my = map_y.ptr<float>(r);
+    const float* x0 = grid_x.ptr<float>(gr);
+    const float* x1 = grid_x.ptr<float>(gr + 1);
+    const float* y0 = grid_y.ptr<float>(gr);
+    const float* y1 = grid_y.ptr<float>(gr + 1);
     for (int c = 0; c < cols; ++c) {
       const int gc = c / kGridPx;
       const float fc = static_cast<float>(c - gc * kGridPx) / kGridPx;
-      const auto lerp = [&](const cv::Mat& g) {
-        const float top = (1 - fc) * g.at<float>(gr, gc) + fc * g.at<float>(gr, gc + 1);
-        const float bottom = (1 - fc) * g.at<float>(gr + 1, gc) + fc * g.at<float>(gr + 1, gc + 1);
+      const auto lerp = [&](const float* g0, const float* g1) {
+        const float top = (1 - fc) * g0[gc] + fc * g0[gc + 1];
+        const float bottom = (1 - fc) * g1[gc] + fc * g1[gc + 1];
         return (1 - fr) * top + fr * bottom;
       };
-      mx[c] = static_cast<float>(c) + lerp(grid_x);
-      my[c] = static_cast<float>(r) + lerp(grid_y);
+      mx[c] = static_cast<float>(c) + lerp(x0, x1);
+      my[c] = static_cast<float>(r) + lerp(y0, y1);
     }
   }
   cv::Mat out;

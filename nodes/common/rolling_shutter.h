@@ -8,6 +8,7 @@
 // translation's part is small beside the rotation's at altitude).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/matx.hpp>
 
@@ -17,6 +18,10 @@ struct CameraTwist {
   Eigen::Vector3d omega_cam_rps = Eigen::Vector3d::Zero();  // angular velocity, camera frame
   Eigen::Vector3d v_cam_mps = Eigen::Vector3d::Zero();      // velocity, camera frame
 };
+
+// The constant twist that moves a camera by T_prev_cur (the frame's pose in
+// the previous frame's camera axes, T_world_cam(k-1)^-1 T_world_cam(k)) in dt_s.
+CameraTwist cameraTwist(const Eigen::Isometry3d& T_prev_cur, double dt_s);
 
 // gray: 8-bit, undistorted, intrinsics K. Throws std::invalid_argument on a
 // bad image or a non-positive depth.

@@ -157,14 +157,10 @@ cv::Mat DirectVo::globalShutterImage(const VoFrameInput& in) const {
   if (!params_.rolling_shutter || !(in.readout_s > 0.0) || keyframes_.empty() ||
       !(delta_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
     return in.gray;
-  // delta_ maps the last frame's camera coordinates to the frame's:
-  // R_world_cam(k) = R_world_cam(k-1) Exp(omega dt) gives Exp(omega dt) =
-  // delta^T, and the camera's centre moved by -R^T t in the last frame's axes.
-  const Eigen::AngleAxisd turn(delta_.linear().transpose());
-  CameraTwist twist;
-  twist.omega_cam_rps = turn.angle() * turn.axis() / delta_period_s_;
-  twist.v_cam_mps = -(delta_.linear().transpose() * delta_.translation()) / delta_period_s_;
-  return rectifyRollingShutter(in.gray, in.K, in.readout_s, twist, *in.range_m);
+  // delta_ maps the last frame's camera coordinates to the frame's: its
+  // inverse is the frame's pose in the last frame's axes.
+  return rectifyRollingShutter(in.gray, in.K, in.readout_s,
+                               cameraTwist(delta_.inverse(), delta_period_s_), *in.range_m);
 }
 
 Eigen::Isometry3d DirectVo::predictCamWorld(int steps) const {

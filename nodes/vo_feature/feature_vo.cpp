@@ -236,13 +236,9 @@ cv::Mat FeatureVo::globalShutterImage(const VoFrameInput& in) const {
   if (!params_.rolling_shutter || !(in.readout_s > 0.0) || status_ != VoStatus::kTracking ||
       !(frame_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
     return in.gray;
-  // T_world_cam(k) = T_world_cam(k-1) T_delta_: the rotation is Exp(omega dt)
-  // and the translation v dt, in the last frame's camera axes.
-  const Eigen::AngleAxisd turn(T_delta_.linear());
-  CameraTwist twist;
-  twist.omega_cam_rps = turn.angle() * turn.axis() / frame_period_s_;
-  twist.v_cam_mps = T_delta_.translation() / frame_period_s_;
-  return rectifyRollingShutter(in.gray, in.K, in.readout_s, twist, *in.range_m);
+  // T_world_cam(k) = T_world_cam(k-1) T_delta_.
+  return rectifyRollingShutter(in.gray, in.K, in.readout_s, cameraTwist(T_delta_, frame_period_s_),
+                               *in.range_m);
 }
 
 Eigen::Isometry3d FeatureVo::predict(int steps) const {
