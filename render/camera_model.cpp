@@ -1,5 +1,6 @@
 #include "render/camera_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -116,6 +117,18 @@ void CameraParams::visit(core::ParamVisitor& v) {
           {.doc = "scene drawn this much wider per side for blur and rolling shutter, px",
            .min = 0,
            .max = 1024});
+}
+
+double vignettingK(double corner_share, const CameraIntrinsics& intrinsics) {
+  if (!(corner_share < 1.0)) return 0.0;
+  const double x = std::max(intrinsics.cx, intrinsics.width - 1 - intrinsics.cx) / intrinsics.fx;
+  const double y = std::max(intrinsics.cy, intrinsics.height - 1 - intrinsics.cy) / intrinsics.fy;
+  return (1.0 / std::sqrt(corner_share) - 1.0) / (x * x + y * y);
+}
+
+double vignettingAt(double k, double x, double y) {
+  const double v = 1.0 + k * (x * x + y * y);
+  return 1.0 / (v * v);
 }
 
 CameraIntrinsics CameraParams::intrinsics() const {

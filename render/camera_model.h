@@ -41,6 +41,14 @@ struct CameraIntrinsics {
   std::optional<Eigen::Vector2d> undistortPixel(const Eigen::Vector2d& uv) const;
 };
 
+// Vignetting V = 1 / (1 + k r^2)^2, r^2 = x^2 + y^2 in normalised image
+// coordinates (x = (u - cx) / fx, y = (v - cy) / fy): the k for which V is
+// corner_share at the image corner farthest from the principal point (0 for
+// corner_share >= 1: no vignetting). The renderer darkens by it; a VO given
+// the lens's calibration divides it out.
+double vignettingK(double corner_share, const CameraIntrinsics& intrinsics);
+double vignettingAt(double k, double x, double y);
+
 // What a rendering camera adds to the intrinsics: clipping, exposure and noise.
 struct CameraParams {
   int width = 1280;

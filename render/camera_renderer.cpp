@@ -361,13 +361,7 @@ void CameraRenderer::createTargets() {
 }
 
 double CameraRenderer::vignettingK() const {
-  if (!params_.vignetting || params_.vignetting_corner >= 1.0) return 0.0;
-  // V(corner) = vignetting_corner at the corner farthest from the principal point.
-  const double x =
-      std::max(intrinsics_.cx, intrinsics_.width - 1 - intrinsics_.cx) / intrinsics_.fx;
-  const double y =
-      std::max(intrinsics_.cy, intrinsics_.height - 1 - intrinsics_.cy) / intrinsics_.fy;
-  return (1.0 / std::sqrt(params_.vignetting_corner) - 1.0) / (x * x + y * y);
+  return params_.vignetting ? render::vignettingK(params_.vignetting_corner, intrinsics_) : 0.0;
 }
 
 double CameraRenderer::exposureGain(std::int64_t utime) {

@@ -1,5 +1,6 @@
 #include "nodes/ppa/ppa_host.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -21,6 +22,11 @@ void PpaHostParams::visit(core::ParamVisitor& v) {
            .max = 1000});
   v.field("min_keyframe_edges", &min_keyframe_edges,
           {.doc = "fewer key-frame edge pixels than this: LOST", .min = 1, .max = 65536});
+  v.field("min_strength_above_chance", &min_strength_above_chance,
+          {.doc = "LOST when the alignment's strength is less than this above a random edge "
+                  "image's, (strength - edge density) / (1 - edge density)",
+           .min = 0,
+           .max = 1});
 }
 
 PpaCamera PpaCamera::fromFov(int width, int height, double hfov_rad,
@@ -126,7 +132,13 @@ PpaHostOutput PpaHost::update(const PpaHostInput& input) {
   }
   const bool featureless = keyframe_->edges < params_.min_keyframe_edges &&
                            input.alignment.keyframe_edge_count < params_.min_keyframe_edges;
-  out.status = featureless ? PpaStatus::kLost : PpaStatus::kTracking;
+  const double pixels = static_cast<double>(camera_.width) * camera_.height;
+  const double edge_density =
+      pixels > 0 ? std::clamp(input.alignment.edge_count / pixels, 0.0, 1.0) : 0.0;
+  out.strength_above_chance =
+      edge_density < 1.0 ? (input.alignment.strength - edge_density) / (1.0 - edge_density) : 0.0;
+  const bool unaligned = out.strength_above_chance < params_.min_strength_above_chance;
+  out.status = featureless || unaligned ? PpaStatus::kLost : PpaStatus::kTracking;
   if (input.alignment.new_keyframe) {
     keyframe_ = Keyframe{out.p_ned_m, R, height_m, input.alignment.keyframe_edge_count};
   }

@@ -37,6 +37,12 @@ struct PpaHostParams {
   // A key-frame with fewer edge pixels than this cannot be aligned to (a
   // featureless view): the estimate is LOST until a better one.
   int min_keyframe_edges = 50;
+  // The alignment shares strength of the key-frame's edges; an edge image of
+  // random pixels would share this frame's edge density by chance (sensor
+  // noise above the edge threshold fills it). Below this much above chance,
+  // (strength - density) / (1 - density), the alignment is no better than a
+  // guess: LOST until it is again.
+  double min_strength_above_chance = 0.07;
 
   void visit(core::ParamVisitor& v);
 };
@@ -53,6 +59,8 @@ struct PpaAlignment {
   // This frame becomes the key-frame for the next ones.
   bool new_keyframe = false;
   int keyframe_edge_count = 0;
+  // Edge pixels of this frame.
+  int edge_count = 0;
 };
 
 // A pinhole camera: image size, focal lengths and principal point, pixels.
@@ -89,6 +97,8 @@ struct PpaHostOutput {
   Eigen::Vector3d correction_m = Eigen::Vector3d::Zero();
   // Height above ground used, m.
   double height_m = 0.0;
+  // The alignment's strength above chance (PpaHostParams::min_strength_above_chance).
+  double strength_above_chance = 0.0;
 };
 
 class PpaHost {

@@ -19,6 +19,8 @@ void DirectVoParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "selection", "which pixels a key-frame hosts", selection);
   core::visitGroup(v, "tracker", "aligning each frame to the newest key-frame", tracker);
   core::visitGroup(v, "window", "the windowed photometric bundle adjustment", window);
+  core::visitGroup(v, "photometric", "the lens's vignetting and response, as calibrated",
+                   photometric);
   v.field("window_keyframes", &window_keyframes,
           {.doc = "key-frames in the optimised window", .min = 2, .max = 16});
   v.field("max_points", &max_points,
@@ -51,8 +53,8 @@ void DirectVoParams::visit(core::ParamVisitor& v) {
            .max = 100});
   v.field("lost_min_in_image", &lost_min_in_image,
           {.doc = "a frame keeping fewer of the points in the image is lost", .min = 0, .max = 1});
-  v.field("lost_pose_sigma_px", &lost_pose_sigma_px,
-          {.doc = "lost when the image fixes the pose to worse than this, 1-sigma image motion, px",
+  v.field("lost_pose_sigma_mrad", &lost_pose_sigma_mrad,
+          {.doc = "lost when the image fixes the pose to worse than this, 1-sigma ray angle, mrad",
            .min = 1e-3,
            .max = 1e6});
   v.field("lost_speed_mps", &lost_speed_mps,
@@ -153,13 +155,13 @@ void DirectVo::dropMap() {
   keyframe_points_.clear();
 }
 
-cv::Mat DirectVo::globalShutterImage(const VoFrameInput& in) const {
+cv::Mat DirectVo::globalShutterImage(const VoFrameInput& in, const cv::Mat& gray) const {
   if (!params_.rolling_shutter || !(in.readout_s > 0.0) || keyframes_.empty() ||
       !(delta_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
-    return in.gray;
+    return gray;
   // delta_ maps the last frame's camera coordinates to the frame's: its
   // inverse is the frame's pose in the last frame's axes.
-  return rectifyRollingShutter(in.gray, in.K, in.readout_s,
+  return rectifyRollingShutter(gray, in.K, in.readout_s,
                                cameraTwist(delta_.inverse(), delta_period_s_), *in.range_m);
 }
 
@@ -211,7 +213,8 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
   frame_time_s_ = static_cast<double>(in.utime) * 1e-6;
 
   auto t0 = Clock::now();
-  const cv::Mat gray = globalShutterImage(in);
+  const cv::Mat gray =
+      globalShutterImage(in, vignetting_.apply(in.gray, in.K, params_.photometric));
   auto pyramid =
       std::make_unique<ImagePyramid>(gray, params_.pyramid_levels, params_.tracker.finest_level);
   timing_.pyramid_s += secondsSince(t0);
@@ -265,21 +268,22 @@ DirectVoOutput DirectVo::process(const VoFrameInput& in) {
   const Eigen::Isometry3d T_cam_world = orthonormalized(result.T_frame_ref * kf.T_cam_world);
   // A frame the image fixes too loosely is reported lost but kept: making
   // the map again over the same faint ground would not fix the pose better.
-  const VoStatus status =
-      result.pose_sigma_px > params_.lost_pose_sigma_px ? VoStatus::kLost : VoStatus::kTracking;
+  const VoStatus status = result.pose_sigma_rad * 1e3 > params_.lost_pose_sigma_mrad
+                              ? VoStatus::kLost
+                              : VoStatus::kTracking;
   if (needKeyframe(result)) {
     addKeyframe(std::move(pyramid), in, T_cam_world, result.affine);
     const Eigen::Isometry3d refined = keyframes_.back().T_cam_world;
     acceptPose(refined, keyframes_.back().affine);
     DirectVoOutput out = output(status, refined, result.points, true);
     out.rms = result.rms;
-    out.pose_sigma_px = result.pose_sigma_px;
+    out.pose_sigma_rad = result.pose_sigma_rad;
     return out;
   }
   acceptPose(T_cam_world, result.affine);
   DirectVoOutput out = output(status, T_cam_world, result.points, false);
   out.rms = result.rms;
-  out.pose_sigma_px = result.pose_sigma_px;
+  out.pose_sigma_rad = result.pose_sigma_rad;
   return out;
 }
 

@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/params.h"
+#include "nodes/common/photometric.h"
 #include "nodes/common/vo_frame.h"
 #include "nodes/vo_direct/frame_tracker.h"
 #include "nodes/vo_direct/image_pyramid.h"
@@ -59,14 +60,14 @@ struct DirectVoParams {
   // image; after lost_frames_before_reset of those the map is made again.
   // A frame is also reported lost, but its pose and the map kept, when the
   // image fixes the pose too loosely: its least-determined direction moves
-  // the image by more than lost_pose_sigma_px at 1 sigma (level-0 px;
-  // TrackResult::pose_sigma_px). Over low-texture ground the estimate drifts
-  // away with every frame otherwise "tracked" (docs/vo_direct.md).
+  // its rays by more than lost_pose_sigma_mrad at 1 sigma
+  // (TrackResult::pose_sigma_rad; 0.286 mrad is 0.2 px at a 700 px focal length). Over low-texture
+  // ground the estimate drifts away with every frame otherwise "tracked" (docs/vo_direct.md).
   double lost_rms_ratio = 3.0;
   double lost_rms_floor = 10.0;
   double lost_log_gain = 0.7;
   double lost_min_in_image = 0.2;
-  double lost_pose_sigma_px = 0.2;
+  double lost_pose_sigma_mrad = 0.286;
   // A frame whose pose puts the camera further from the last good one than
   // this speed allows is lost: no vehicle nadir flies is faster, and a pose
   // fitted to faint texture can leap by kilometres.
@@ -75,6 +76,9 @@ struct DirectVoParams {
   // to a global shutter at their stamp, with the motion model's velocity
   // (rolling_shutter.h), before they are tracked.
   bool rolling_shutter = true;
+  // The lens's vignetting and the response, as calibrated: frames are
+  // divided by the vignetting before they are tracked (photometric.h).
+  PhotometricCalibration photometric;
   // Lost frames in a row before the map is dropped and made again.
   int lost_frames_before_reset = 3;
   // Points of a key-frame within this of the rangefinder ray's image carry
@@ -107,8 +111,8 @@ struct DirectVoOutput {
   int resets = 0;
   AffineBrightness affine;  // the frame's brightness
   double rms = 0.0;         // the alignment's RMS residual
-  // How loosely the image fixes the pose (TrackResult::pose_sigma_px).
-  double pose_sigma_px = 0.0;
+  // How loosely the image fixes the pose (TrackResult::pose_sigma_rad).
+  double pose_sigma_rad = 0.0;
 };
 
 class DirectVo {
@@ -151,7 +155,7 @@ class DirectVo {
   TrackResult track(const ImagePyramid& pyramid);
   bool isLost(const TrackResult& result) const;
   // The frame as a global shutter would see it (rolling_shutter).
-  cv::Mat globalShutterImage(const VoFrameInput& in) const;
+  cv::Mat globalShutterImage(const VoFrameInput& in, const cv::Mat& gray) const;
   // The frame's pose when it is lost: the motion model's.
   DirectVoOutput lostFrame(std::unique_ptr<ImagePyramid> pyramid, const VoFrameInput& in,
                            int points);
@@ -204,6 +208,7 @@ class DirectVo {
   int resets_ = 0;
 
   DirectVoTiming timing_;
+  VignettingCorrection vignetting_;
   cv::Mat keyframe_image_;
   std::vector<DepthPixel> keyframe_points_;
 };

@@ -242,8 +242,8 @@ LevelSystem evaluate(const std::vector<TrackingPoint>& points, std::vector<char>
   return sys;
 }
 
-// See TrackResult::pose_sigma_px. xi = (translation, rotation).
-double poseSigmaPx(const Matrix8d& H, double rms, double focal_px, double mean_idepth) {
+// See TrackResult::pose_sigma_rad. xi = (translation, rotation).
+double poseSigma_rad(const Matrix8d& H, double rms, double mean_idepth) {
   const Eigen::LDLT<Matrix8d> ldlt(H);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return 1e9;
   const Matrix8d covariance = ldlt.solve(Matrix8d::Identity()) * (rms * rms);
@@ -254,7 +254,7 @@ double poseSigmaPx(const Matrix8d& H, double rms, double focal_px, double mean_i
                                                                 Eigen::EigenvaluesOnly);
   const double sigma_t = std::sqrt(std::max(0.0, translation.eigenvalues().maxCoeff()));
   const double sigma_r = std::sqrt(std::max(0.0, rotation.eigenvalues().maxCoeff()));
-  return focal_px * (sigma_r + sigma_t * mean_idepth);
+  return sigma_r + sigma_t * mean_idepth;
 }
 
 }  // namespace
@@ -320,9 +320,7 @@ TrackResult trackFrame(const TrackingReference& reference, const ImagePyramid& f
     result.in_image_share =
         sys.points_total > 0 ? static_cast<double>(sys.points_in) / sys.points_total : 0.0;
     result.points = sys.points_in;
-    if (l == finest)
-      result.pose_sigma_px =
-          poseSigmaPx(sys.H, rms, reference.cameras[l].fx * (1 << l), reference.mean_idepth);
+    if (l == finest) result.pose_sigma_rad = poseSigma_rad(sys.H, rms, reference.mean_idepth);
   }
   result.T_frame_ref = T;
   result.affine = affine;

@@ -93,11 +93,12 @@ struct TrackResult {
   int iterations = 0;
   // The same at the coarsest level (a bad start shows there first).
   double coarse_rms = 0.0;
-  // How well the image fixes the pose: the 1-sigma image motion, level-0 px,
-  // of the pose's least-determined rotation and translation (at the points'
-  // mean depth), from the finest level's Gauss-Newton covariance scaled by
-  // the residuals' RMS. Low texture leaves directions the image cannot tell.
-  double pose_sigma_px = 0.0;
+  // How well the image fixes the pose: the 1-sigma angle, rad, by which the
+  // pose's least-determined rotation and translation (at the points' mean
+  // depth) turn the rays, from the finest level's Gauss-Newton covariance
+  // scaled by the residuals' RMS. Low texture leaves directions the image
+  // cannot tell. An angle, so that one threshold serves every resolution.
+  double pose_sigma_rad = 0.0;
 };
 
 // frame needs gradients at every level the reference holds.

@@ -55,6 +55,8 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "features", "ORB extraction", features);
   core::visitGroup(v, "two_view", "two-view initialisation", two_view);
   core::visitGroup(v, "ba", "local bundle adjustment", ba);
+  core::visitGroup(v, "photometric", "the lens's vignetting and response, as calibrated",
+                   photometric);
   v.field("min_init_matches", &min_init_matches,
           {.doc = "initialise only from at least this many matches", .min = 8, .max = 100000});
   v.field("min_tracked_points", &min_tracked_points,
@@ -232,12 +234,12 @@ int FeatureVo::numMapPoints() const {
       std::count_if(points_.begin(), points_.end(), [](const MapPoint& p) { return !p.bad; }));
 }
 
-cv::Mat FeatureVo::globalShutterImage(const VoFrameInput& in) const {
+cv::Mat FeatureVo::globalShutterImage(const VoFrameInput& in, const cv::Mat& gray) const {
   if (!params_.rolling_shutter || !(in.readout_s > 0.0) || status_ != VoStatus::kTracking ||
       !(frame_period_s_ > 0.0) || !in.range_m || !(*in.range_m > 0.0))
-    return in.gray;
+    return gray;
   // T_world_cam(k) = T_world_cam(k-1) T_delta_.
-  return rectifyRollingShutter(in.gray, in.K, in.readout_s, cameraTwist(T_delta_, frame_period_s_),
+  return rectifyRollingShutter(gray, in.K, in.readout_s, cameraTwist(T_delta_, frame_period_s_),
                                *in.range_m);
 }
 
@@ -286,7 +288,9 @@ VoFrameOutput FeatureVo::processFrame(const VoFrameInput& in) {
   last_utime_ = in.utime;
   Frame cur;
   cur.id = frame_index_;
-  cur.features = extractOrb(globalShutterImage(in), params_.features);
+  cur.features =
+      extractOrb(globalShutterImage(in, vignetting_.apply(in.gray, in.K, params_.photometric)),
+                 params_.features);
   cur.point_of_feature.assign(cur.features.keypoints.size(), -1);
   timing_.extract_s += secondsSince(stage_start);
   last_features_.clear();

@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/params.h"
+#include "nodes/common/photometric.h"
 #include "nodes/common/vo_frame.h"
 #include "nodes/vo_feature/bundle_adjustment.h"
 #include "nodes/vo_feature/debug_image.h"
@@ -76,6 +77,9 @@ struct FeatureVoParams {
   // to a global shutter at their stamp, with the motion model's velocity,
   // before features are found (nodes/common/rolling_shutter.h).
   bool rolling_shutter = true;
+  // The lens's vignetting and the response, as calibrated: frames are
+  // divided by the vignetting before features are found (photometric.h).
+  PhotometricCalibration photometric;
   // Scale upkeep: correct when |range ratio - 1| exceeds this, by this share.
   double scale_tolerance = 0.002;
   double scale_gain = 0.5;
@@ -174,7 +178,7 @@ class FeatureVo {
   std::optional<double> mapRange(const Frame& kf, const VoFrameInput& in) const;
   Eigen::Isometry3d predict(int steps) const;
   // The frame as a global shutter would see it (rolling_shutter).
-  cv::Mat globalShutterImage(const VoFrameInput& in) const;
+  cv::Mat globalShutterImage(const VoFrameInput& in, const cv::Mat& gray) const;
 
   FeatureVoParams params_;
   Eigen::Isometry3d T_world_body_start_ = Eigen::Isometry3d::Identity();
@@ -209,6 +213,7 @@ class FeatureVo {
   int resets_ = 0;
   double last_scale_ratio_ = 1.0;
   FeatureVoTiming timing_;
+  VignettingCorrection vignetting_;
   std::vector<DebugFeature> last_features_;
   // Counts map resets: a background BA of an earlier map is dropped.
   std::int64_t map_generation_ = 0;

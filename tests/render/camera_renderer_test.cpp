@@ -15,6 +15,7 @@
 
 #include "checker_world.h"
 #include "core/frames.h"
+#include "nodes/common/photometric.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
 
@@ -433,6 +434,34 @@ TEST(CameraRenderer, VignettingDarkensTowardsTheCornersAsWorkedOut) {
     EXPECT_NEAR(image.at<std::uint8_t>(v, u), expected, 1.0) << "pixel " << u << ", " << v;
   }
   EXPECT_NEAR(image.at<std::uint8_t>(0, 0), 64.0, 1.0);
+}
+
+// The VOs' calibration divides out what the renderer's lens and response
+// did: the world's uniform 128-count gray, vignetted to half at the corners
+// and through a gamma of 2.2, comes back within two counts of the same gray
+// frame without vignetting, over the whole image.
+TEST(CameraRenderer, TheVosVignettingCorrectionUndoesTheLens) {
+  Fixture fixture;
+  CameraParams params = testCamera();
+  params.response_curve = true;
+  params.response_gamma = 2.2;
+  CameraRenderer flat_camera(*fixture.terrain, params);
+  const cv::Mat flat = flat_camera.render(kOverGray, 0).image;
+  params.vignetting = true;
+  params.vignetting_corner = 0.5;
+  CameraRenderer camera(*fixture.terrain, params);
+  const cv::Mat vignetted = camera.render(kOverGray, 0).image;
+  const CameraIntrinsics& k = camera.intrinsics();
+  const cv::Matx33d K(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
+  vo::VignettingCorrection correction;
+  const cv::Mat corrected =
+      correction.apply(vignetted, K, {.vignetting_corner = 0.5, .response_gamma = 2.2});
+  cv::Mat difference;
+  cv::absdiff(corrected, flat, difference);
+  double worst = 0.0;
+  cv::minMaxLoc(difference, nullptr, &worst);
+  EXPECT_LE(worst, 2.0);
+  EXPECT_GT(cv::norm(vignetted, flat, cv::NORM_INF), 40.0) << "the lens should darken the corners";
 }
 
 // A gamma response: 255 (128 / 255)^(1 / 2.2) = 186.4 counts.

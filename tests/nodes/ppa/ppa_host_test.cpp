@@ -30,6 +30,9 @@ PpaHostInput frame(double range_m, const core::RollPitchYaw& rpy, double tx_px, 
   input.alignment.translation_y_px = ty_px;
   input.alignment.new_keyframe = new_keyframe;
   input.alignment.keyframe_edge_count = 1000;
+  // A well-aligned frame: 60 % of the key-frame's edges shared, 1000 of 65536 pixels edges.
+  input.alignment.strength = 0.6;
+  input.alignment.edge_count = 1000;
   return input;
 }
 
@@ -41,6 +44,32 @@ TEST(PpaHost, StartsAtTheGivenPose) {
   const PpaHostOutput out = host.update(frame(5.0, {}, 0, 0, true));
   EXPECT_EQ(out.status, PpaStatus::kTracking);
   EXPECT_NEAR((out.p_ned_m - Eigen::Vector3d(10.0, 20.0, -7.0)).norm(), 0.0, 1e-12);
+}
+
+// Sensor noise above the edge threshold fills the edge image: half the
+// pixels edges (32768 of 256 x 256) share half of any key-frame's edges by
+// chance. A strength of 0.52 is (0.52 - 0.5) / (1 - 0.5) = 0.04 above that
+// chance, under the default 0.07: LOST; 0.6 is 0.2 above it: TRACKING. The
+// same 0.52 over a sparse edge image (1000 edges) is 0.51 above chance.
+TEST(PpaHost, AnAlignmentNoBetterThanChanceIsLost) {
+  PpaHost host = makeHost();
+  host.initialise({0, 0, -5});
+  host.update(frame(5.0, {}, 0, 0, true));
+  PpaHostInput noisy = frame(5.0, {}, 1.0, 0.0);
+  noisy.alignment.edge_count = 32768;
+  noisy.alignment.strength = 0.52;
+  const PpaHostOutput guess = host.update(noisy);
+  EXPECT_NEAR(guess.strength_above_chance, 0.04, 1e-12);
+  EXPECT_EQ(guess.status, PpaStatus::kLost);
+  noisy.alignment.strength = 0.6;
+  const PpaHostOutput aligned = host.update(noisy);
+  EXPECT_NEAR(aligned.strength_above_chance, 0.2, 1e-12);
+  EXPECT_EQ(aligned.status, PpaStatus::kTracking);
+  PpaHostInput sparse = frame(5.0, {}, 1.0, 0.0);
+  sparse.alignment.strength = 0.52;
+  const PpaHostOutput clean = host.update(sparse);
+  EXPECT_NEAR(clean.strength_above_chance, (0.52 - 1000.0 / 65536) / (1 - 1000.0 / 65536), 1e-12);
+  EXPECT_EQ(clean.status, PpaStatus::kTracking);
 }
 
 // Level, heading north at 5 m: the ground below now sits 10 px above the key-frame's

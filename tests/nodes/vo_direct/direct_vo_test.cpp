@@ -239,7 +239,7 @@ TEST(DirectVo, ReportsLostOverGroundTooFaintToFixThePose) {
   faint.highest = 134.0;
   const FaintFlight checked = flyOverNoisyGround(faint, {});
   DirectVoParams unchecked_params;
-  unchecked_params.lost_pose_sigma_px = 1e6;
+  unchecked_params.lost_pose_sigma_mrad = 1e6;
   const FaintFlight unchecked = flyOverNoisyGround(faint, unchecked_params);
   std::printf(
       "of 29 frames: ordinary %d tracked (worst %.2f m); faint %d tracked, %d lost; "
