@@ -12,20 +12,76 @@
 //   nadir run thesis-oscillating --set vehicle.altitude_agl_m=300
 //       --set vo_feature.enabled=false --out out/rec300   (one line)
 //   nadir-bench-vo-feature out/rec300 [--out DIR] [--set vo_feature.attitude_prior=true]
+//
+// --drift-every-s S adds the map's tilt, heading and height error against the
+// truth every S seconds, and it prints how many key-frames saw the points the
+// map dropped (docs/vo_feature.md, "Where the tilt comes from").
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <iostream>
+#include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 
 #include "bench/vo_replay.h"
+#include "core/trajectory.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/scenario.h"
 #include "nodes/vo_feature/vo_feature_node.h"
+
+namespace {
+
+// Of the points the map dropped, how many key-frames saw them.
+void printMapStats(const nadir::vo::FeatureVoMapStats& stats) {
+  if (stats.points_dropped == 0) return;
+  std::printf("points dropped    %lld; key-frames that saw them:",
+              static_cast<long long>(stats.points_dropped));
+  std::int64_t cumulative = 0;
+  std::int64_t median_bin = -1;
+  for (std::size_t k = 0; k < stats.points_by_keyframes.size(); ++k) {
+    cumulative += stats.points_by_keyframes[k];
+    if (median_bin < 0 && 2 * cumulative >= stats.points_dropped)
+      median_bin = static_cast<std::int64_t>(k);
+  }
+  std::printf(" median %lld\n", static_cast<long long>(median_bin));
+  for (std::size_t k = 0; k < stats.points_by_keyframes.size(); ++k)
+    if (stats.points_by_keyframes[k] > 0)
+      std::printf("  %2zu%s key-frames  %5.1f %%\n", k,
+                  k + 1 == stats.points_by_keyframes.size() ? "+" : " ",
+                  100.0 * static_cast<double>(stats.points_by_keyframes[k]) /
+                      static_cast<double>(stats.points_dropped));
+}
+
+// The estimate's error against the truth at every step_s of its tracked poses:
+// the world-frame rotation error R_est R_true^T as a rotation vector (about
+// north and east: the map's tilt; about down: its heading), and the height
+// and horizontal position errors.
+void printDrift(const nadir::core::Trajectory& truth, const nadir::core::Trajectory& estimate,
+                double step_s) {
+  if (estimate.empty()) return;
+  std::printf("\n    t s  tilt N deg  tilt E deg  heading deg  height m  horizontal m\n");
+  const double t0 = estimate.front().t_s;
+  double next = t0;
+  for (const nadir::core::StampedPose& e : estimate) {
+    if (e.t_s < next && &e != &estimate.back()) continue;
+    next = e.t_s + step_s;
+    const std::optional<nadir::core::StampedPose> t = nadir::core::interpolate(truth, e.t_s, 0.1);
+    if (!t) continue;
+    const Eigen::AngleAxisd error(e.q_world_body * t->q_world_body.conjugate());
+    const Eigen::Vector3d rv_deg = error.angle() * error.axis() * 180.0 / std::numbers::pi;
+    const Eigen::Vector3d dp = e.p_ned_m - t->p_ned_m;
+    std::printf("  %5.1f  %10.3f  %10.3f  %11.3f  %8.2f  %12.2f\n", e.t_s - t0, rv_deg.x(),
+                rv_deg.y(), rv_deg.z(), -dp.z(), dp.head<2>().norm());
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"The feature VO over a recorded run's images: frames/s and accuracy"};
@@ -36,6 +92,7 @@ int main(int argc, char** argv) {
   int threads = 1;
   std::string debug_png;
   double debug_at_s = 60.0;
+  double drift_every_s = 0.0;
   app.add_option("run_dir", run_dir, "a nadir run folder recorded with images")->required();
   app.add_option("--out", out_dir, "where the estimates and metrics go (default RUN_DIR/bench)");
   app.add_option("--set", overrides, "override a scenario parameter: key=value (repeatable)");
@@ -45,6 +102,9 @@ int main(int argc, char** argv) {
   app.add_option("--debug-png", debug_png,
                  "write the debug image (tracked features) nearest after --debug-at-s here");
   app.add_option("--debug-at-s", debug_at_s, "seconds from the first image, for --debug-png");
+  app.add_option("--drift-every-s", drift_every_s,
+                 "print the map's tilt, heading and height error against the truth every this "
+                 "many seconds (0: not)");
   CLI11_PARSE(app, argc, argv);
   cv::setNumThreads(threads);
 
@@ -90,6 +150,10 @@ int main(int argc, char** argv) {
     const nadir::eval::RunEvaluation evaluation =
         nadir::eval::evaluateRunLog(replay.estimatesLog(), folder.out.string(), options);
     std::cout << nadir::eval::formatResultsTable(evaluation.metrics);
+    printMapStats(node.vo().mapStats());
+    const auto tracked = evaluation.tracked.find(nadir::vo::kFeatureSourceName);
+    if (drift_every_s > 0.0 && tracked != evaluation.tracked.end())
+      printDrift(evaluation.recorded.truth, tracked->second, drift_every_s);
     return 0;
   } catch (const std::exception& error) {
     std::cerr << "nadir-bench-vo-feature: " << error.what() << '\n';

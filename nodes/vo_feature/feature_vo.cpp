@@ -193,7 +193,7 @@ bool FeatureVo::seedMapFromRange(Frame& cur, const VoFrameInput& in) {
     std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
     return false;
   }
-  keyframes_.push_back(cur);
+  pushKeyframe(cur);
   return true;
 }
 
@@ -214,6 +214,13 @@ void FeatureVo::compactMap() {
     else
       new_index[i] = -1;
   if (static_cast<std::size_t>(alive) * 2 > points_.size()) return;
+  const std::size_t last_bin = map_stats_.points_by_keyframes.size() - 1;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    if (new_index[i] >= 0) continue;
+    ++map_stats_.points_dropped;
+    ++map_stats_.points_by_keyframes[std::min(
+        last_bin, static_cast<std::size_t>(std::max(points_[i].keyframes_seen, 0)))];
+  }
   std::vector<MapPoint> kept;
   kept.reserve(static_cast<std::size_t>(alive));
   for (std::size_t i = 0; i < points_.size(); ++i)
@@ -222,6 +229,12 @@ void FeatureVo::compactMap() {
   for (Frame& kf : keyframes_)
     for (int& id : kf.point_of_feature)
       if (id >= 0) id = new_index[static_cast<std::size_t>(id)];
+}
+
+void FeatureVo::pushKeyframe(Frame kf) {
+  for (int id : kf.point_of_feature)
+    if (id >= 0) ++points_[static_cast<std::size_t>(id)].keyframes_seen;
+  keyframes_.push_back(std::move(kf));
 }
 
 void FeatureVo::markTracked(const Frame& frame) {
@@ -436,8 +449,8 @@ VoFrameOutput FeatureVo::initialise(Frame& cur, const VoFrameInput& in,
   T_world_cam_last_ = cur.T_world_cam;
   frames_since_good_ = 0;
   lost_count_ = 0;
-  keyframes_.push_back(std::move(ref));
-  keyframes_.push_back(cur);
+  pushKeyframe(std::move(ref));
+  pushKeyframe(cur);
   reference_.reset();
   status_ = VoStatus::kTracking;
   return output(VoStatus::kTracking, cur.T_world_cam, T_body_cam,
@@ -572,7 +585,7 @@ std::optional<double> FeatureVo::mapRange(const Frame& kf, const VoFrameInput& i
 void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   Frame kf = cur;
   triangulateNewPoints(kf, in.K);
-  keyframes_.push_back(std::move(kf));
+  pushKeyframe(std::move(kf));
   while (static_cast<int>(keyframes_.size()) > params_.local_window) keyframes_.pop_front();
   compactMap();
   if (++keyframes_since_ba_ >= params_.ba_every_keyframes && localBundleAdjust(in.K))
@@ -660,6 +673,7 @@ int FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::
     const int i_new = index_new[static_cast<std::size_t>(m.trainIdx)];
     MapPoint mp;
     mp.p_world = kf_prev.T_world_cam * t.p_1;
+    mp.keyframes_seen = 1;  // kf_prev, already in the window
     mp.descriptor = kf_new.features.descriptors.row(i_new).clone();
     const int id = static_cast<int>(points_.size());
     points_.push_back(std::move(mp));

@@ -100,6 +100,15 @@ struct FeatureVoTiming {
   std::int64_t keyframes = 0;
 };
 
+// How long the map's points lived: of the points dropped from the map (no
+// key-frame of the window sees them any more), how many saw each number of
+// key-frames (diagnostics: docs/vo_feature.md, "Where the tilt comes from").
+struct FeatureVoMapStats {
+  // points_by_keyframes[k]: points seen by k key-frames (the last bin: that many or more).
+  std::vector<std::int64_t> points_by_keyframes = std::vector<std::int64_t>(33, 0);
+  std::int64_t points_dropped = 0;
+};
+
 struct VoFrameOutput {
   VoStatus status = VoStatus::kInitializing;
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
@@ -132,6 +141,7 @@ class FeatureVo {
   // Points held in memory, alive or not (for tests of the memory bound).
   std::size_t storedMapPoints() const { return points_.size(); }
   const FeatureVoTiming& timing() const { return timing_; }
+  const FeatureVoMapStats& mapStats() const { return map_stats_; }
   // The last frame's features, each marked if it was matched to the map (the debug image).
   const std::vector<DebugFeature>& lastFrameFeatures() const { return last_features_; }
 
@@ -140,6 +150,7 @@ class FeatureVo {
     Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
     cv::Mat descriptor;  // 1 x 32, CV_8U
     bool bad = false;
+    int keyframes_seen = 0;  // key-frames that have observed it
   };
   struct Frame {
     Features features;
@@ -154,6 +165,8 @@ class FeatureVo {
   void resetMap();
   void markTracked(const Frame& frame);
   void compactMap();
+  // Appends a key-frame, counting it in its points' keyframes_seen.
+  void pushKeyframe(Frame kf);
   void addAttitudePriors(BaProblem& problem, const std::vector<const Frame*>& frames) const;
   bool seedMapFromRange(Frame& cur, const VoFrameInput& in);
   VoFrameOutput initialise(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_body_cam,
@@ -213,6 +226,7 @@ class FeatureVo {
   int resets_ = 0;
   double last_scale_ratio_ = 1.0;
   FeatureVoTiming timing_;
+  FeatureVoMapStats map_stats_;
   VignettingCorrection vignetting_;
   std::vector<DebugFeature> last_features_;
   // Counts map resets: a background BA of an earlier map is dropped.

@@ -56,6 +56,7 @@ struct FlightRun {
   std::vector<VoFrameOutput> out;
   double ms_per_frame = 0.0;
   double scale_ratio = 1.0;  // map height / measured height at the last key-frame
+  FeatureVoMapStats map_stats;
 };
 
 // Frames [noise_begin, noise_end) are pure noise (the camera blinded).
@@ -93,6 +94,7 @@ FlightRun fly(int frames, int noise_begin = -1, int noise_end = -1,
   }
   run.ms_per_frame = total_ms / frames;
   run.scale_ratio = vo.lastScaleRatio();
+  run.map_stats = vo.mapStats();
   return run;
 }
 
@@ -147,6 +149,24 @@ TEST(FeatureVo, TracksStraightAndTurningFlightAtMetricScale) {
   EXPECT_LT(end_error, 0.02 * flown);
   EXPECT_LT(yaw_error_deg, 1.0);
   EXPECT_EQ(run.out.back().resets, 0);
+}
+
+// The map's diagnostics count the key-frames that saw each point it drops:
+// on a flight without a loss every point is made from two key-frames (the
+// two-view start or a triangulation), so none was seen by fewer than two,
+// and the bins add up to the points dropped. A window of 3 key-frames drops
+// points within the flight.
+TEST(FeatureVo, CountsTheKeyframesThatSawEachDroppedPoint) {
+  FeatureVoParams params;
+  params.local_window = 3;
+  const FlightRun run = fly(120, -1, -1, params);
+  const FeatureVoMapStats& stats = run.map_stats;
+  ASSERT_GT(stats.points_dropped, 0);
+  EXPECT_EQ(stats.points_by_keyframes[0], 0);
+  EXPECT_EQ(stats.points_by_keyframes[1], 0);
+  std::int64_t total = 0;
+  for (const std::int64_t n : stats.points_by_keyframes) total += n;
+  EXPECT_EQ(total, stats.points_dropped);
 }
 
 // A frame of pure noise mid-flight is LOST; the next frames track again and the pose does not jump.
