@@ -39,6 +39,10 @@ namespace {
 
 // Of the points the map dropped, how many key-frames saw them.
 void printMapStats(const nadir::vo::FeatureVoMapStats& stats) {
+  std::printf(
+      "map upkeep        %lld observations fused, %lld points merged, %lld new points culled\n",
+      static_cast<long long>(stats.observations_fused), static_cast<long long>(stats.points_merged),
+      static_cast<long long>(stats.points_culled));
   if (stats.points_dropped == 0) return;
   std::printf("points dropped    %lld; key-frames that saw them:",
               static_cast<long long>(stats.points_dropped));
@@ -137,7 +141,7 @@ int main(int argc, char** argv) {
                 msPerFrame(t.mapping_s, t.frames), msPerFrame(t.mapping_s, t.keyframes),
                 params.vo.background_ba ? "in a background thread, not counted"
                                         : "at its key-frame, counted");
-    std::printf("map at the end    %d points alive, %zu stored, %d key-frames in the window\n",
+    std::printf("map at the end    %d points alive, %zu stored, %d key-frames in the map\n",
                 node.vo().numMapPoints(), node.vo().storedMapPoints(), node.vo().numKeyframes());
     std::printf("wall (with log)   %.1f s\n", wall_s);
     if (!debug_png.empty())

@@ -70,11 +70,34 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
            .min = 0.1,
            .max = 180.0});
   v.field("local_window", &local_window,
-          {.doc = "key-frames in the local bundle adjustment", .min = 2, .max = 100});
+          {.doc = "key-frames the local BA optimises: the new one and its most co-visible",
+           .min = 2,
+           .max = 100});
+  v.field("map_keyframes", &map_keyframes,
+          {.doc = "key-frames the map keeps (the oldest dropped beyond)", .min = 2, .max = 1000});
+  v.field("min_covisible_points", &min_covisible_points,
+          {.doc = "two key-frames are co-visible when they share at least this many points",
+           .min = 1,
+           .max = 100000});
+  v.field("fuse_radius_px", &fuse_radius_px,
+          {.doc = "fusion: a point takes a co-visible key-frame's feature within this of its "
+                  "projection, px (0: no fusion)",
+           .min = 0.0,
+           .max = 100.0});
+  v.field("point_min_found_ratio", &point_min_found_ratio,
+          {.doc = "a new point is dropped when found in fewer than this share of the frames "
+                  "it was in view of",
+           .min = 0.0,
+           .max = 1.0});
+  v.field("point_min_keyframes", &point_min_keyframes,
+          {.doc = "a new point is dropped when fewer key-frames see it two key-frames on",
+           .min = 0,
+           .max = 100});
   v.field("ba_every_keyframes", &ba_every_keyframes,
           {.doc = "local bundle adjustment every this many key-frames", .min = 1, .max = 1000});
   v.field("triangulation_keyframes", &triangulation_keyframes,
-          {.doc = "earlier key-frames (widest baseline first) a new key-frame triangulates with",
+          {.doc = "co-visible key-frames (widest baseline first) a new key-frame triangulates "
+                  "with",
            .min = 1,
            .max = 100});
   v.field("background_ba", &background_ba,
@@ -144,6 +167,7 @@ void FeatureVo::resetMap() {
   reference_range_m_.reset();
   points_.clear();
   keyframes_.clear();
+  local_keyframe_ids_.clear();
   keyframes_since_ba_ = 0;
   keyframe_peak_shared_ = 0;
 }
@@ -357,7 +381,11 @@ VoFrameOutput FeatureVo::processFrame(const VoFrameInput& in) {
   markTracked(cur);
   seeded_unconfirmed_ = false;
   int tracked = 0;
-  for (int id : cur.point_of_feature) tracked += id >= 0 ? 1 : 0;
+  for (int id : cur.point_of_feature)
+    if (id >= 0) {
+      ++points_[static_cast<std::size_t>(id)].found;
+      ++tracked;
+    }
   if (frames_since_good_ == 1) T_delta_ = T_world_cam_last_.inverse() * cur.T_world_cam;
   lost_count_ = 0;
   status_ = VoStatus::kTracking;
@@ -467,40 +495,43 @@ bool FeatureVo::track(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3
   return false;
 }
 
-int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
-                               double radius_px) {
-  std::vector<int> ids;
-  for (const Frame& kf : keyframes_)
-    for (int id : kf.point_of_feature)
-      if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad) ids.push_back(id);
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-
-  const Eigen::Isometry3d T_cam_world = T_pred.inverse();
-  const double w = in.gray.cols;
-  const double h = in.gray.rows;
-  Features local;
-  std::vector<cv::Point2f> predicted;
-  std::vector<int> local_ids;
+FeatureVo::ProjectedPoints FeatureVo::projectPoints(const std::vector<int>& ids,
+                                                    const Eigen::Isometry3d& T_world_cam,
+                                                    const cv::Matx33d& K, cv::Size image_size,
+                                                    double margin_px) const {
+  ProjectedPoints out;
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const double w = image_size.width;
+  const double h = image_size.height;
   std::vector<cv::Mat> rows;
   for (int id : ids) {
     const MapPoint& mp = points_[static_cast<std::size_t>(id)];
     const Eigen::Vector3d p_cam = T_cam_world * mp.p_world;
     if (p_cam.z() <= 0.0) continue;
-    const Eigen::Vector2d px = project(in.K, p_cam);
-    if (px.x() < -radius_px || px.y() < -radius_px || px.x() > w + radius_px ||
-        px.y() > h + radius_px)
+    const Eigen::Vector2d px = project(K, p_cam);
+    if (px.x() < -margin_px || px.y() < -margin_px || px.x() > w + margin_px ||
+        px.y() > h + margin_px)
       continue;
-    local.keypoints.emplace_back(
-        cv::Point2f(static_cast<float>(px.x()), static_cast<float>(px.y())), 31.0f);
-    predicted.push_back(local.keypoints.back().pt);
+    out.in_image.push_back(px.x() >= 0.0 && px.y() >= 0.0 && px.x() < w && px.y() < h ? 1 : 0);
+    out.px.emplace_back(static_cast<float>(px.x()), static_cast<float>(px.y()));
+    out.features.keypoints.emplace_back(out.px.back(), 31.0f);
     rows.push_back(mp.descriptor);
-    local_ids.push_back(id);
+    out.ids.push_back(id);
   }
-  if (static_cast<int>(local_ids.size()) < params_.min_tracked_points) return 0;
-  cv::vconcat(rows, local.descriptors);
+  if (!rows.empty()) cv::vconcat(rows, out.features.descriptors);
+  return out;
+}
+
+int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
+                               double radius_px) {
+  const std::vector<int> ids = localMapPoints();
+  const ProjectedPoints local = projectPoints(ids, T_pred, in.K, in.gray.size(), radius_px);
+  if (radius_px == params_.track_radius_px)
+    for (std::size_t j = 0; j < local.ids.size(); ++j)
+      if (local.in_image[j] != 0) ++points_[static_cast<std::size_t>(local.ids[j])].visible;
+  if (static_cast<int>(local.ids.size()) < params_.min_tracked_points) return 0;
   const std::vector<cv::DMatch> matches =
-      matchByWindow(local, cur.features, predicted, static_cast<float>(radius_px),
+      matchByWindow(local.features, cur.features, local.px, static_cast<float>(radius_px),
                     params_.max_hamming, static_cast<float>(params_.match_ratio));
   if (static_cast<int>(matches.size()) < params_.min_tracked_points) return 0;
 
@@ -508,7 +539,7 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
   std::vector<cv::Point2d> image;
   for (const cv::DMatch& m : matches) {
     const Eigen::Vector3d& p =
-        points_[static_cast<std::size_t>(local_ids[static_cast<std::size_t>(m.queryIdx)])].p_world;
+        points_[static_cast<std::size_t>(local.ids[static_cast<std::size_t>(m.queryIdx)])].p_world;
     object.emplace_back(p.x(), p.y(), p.z());
     const cv::Point2f& px = cur.features.keypoints[static_cast<std::size_t>(m.trainIdx)].pt;
     image.emplace_back(px.x, px.y);
@@ -549,7 +580,7 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
     if (result.outlier[k]) continue;
     const cv::DMatch& m = matches[static_cast<std::size_t>(inliers[k])];
     cur.point_of_feature[static_cast<std::size_t>(m.trainIdx)] =
-        local_ids[static_cast<std::size_t>(m.queryIdx)];
+        local.ids[static_cast<std::size_t>(m.queryIdx)];
     ++tracked;
   }
   cur.T_world_cam = problem.cameras[0].T_world_cam;
@@ -583,11 +614,16 @@ std::optional<double> FeatureVo::mapRange(const Frame& kf, const VoFrameInput& i
 }
 
 void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
-  Frame kf = cur;
-  triangulateNewPoints(kf, in.K);
-  pushKeyframe(std::move(kf));
-  while (static_cast<int>(keyframes_.size()) > params_.local_window) keyframes_.pop_front();
+  ++keyframes_made_;
+  pushKeyframe(cur);
+  triangulateNewPoints(keyframes_.back(), in.K);
+  fuseNewKeyframe(in.K, in.gray.size());
+  cullNewPoints();
+  while (static_cast<int>(keyframes_.size()) > params_.map_keyframes) keyframes_.pop_front();
   compactMap();
+  local_keyframe_ids_ = {keyframes_.back().id};
+  for (std::size_t k : covisibleKeyframes(keyframes_.size() - 1))
+    local_keyframe_ids_.push_back(keyframes_[k].id);
   if (++keyframes_since_ba_ >= params_.ba_every_keyframes && localBundleAdjust(in.K))
     keyframes_since_ba_ = 0;
   if (!in.range_m) return;
@@ -596,16 +632,150 @@ void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   if (!map_range || !(*map_range > 0.0)) return;
   last_scale_ratio_ = *map_range / *in.range_m;
   if (std::abs(last_scale_ratio_ - 1.0) <= params_.scale_tolerance) return;
-  // Scale the new key-frame's points about its centre: its pose stays, the
-  // motion measured from here on comes out closer to metric.
-  const double factor = 1.0 + params_.scale_gain * (1.0 / last_scale_ratio_ - 1.0);
-  const Eigen::Vector3d c = newest.T_world_cam.translation();
-  for (int id : newest.point_of_feature)
-    if (id >= 0) {
-      MapPoint& mp = points_[static_cast<std::size_t>(id)];
-      mp.p_world = c + factor * (mp.p_world - c);
-    }
+  // Scale the whole map about the new key-frame's centre, a similarity that
+  // keeps every attitude: its pose stays, the motion measured from here on
+  // comes out closer to metric.
+  scaleMap(newest.T_world_cam.translation(),
+           1.0 + params_.scale_gain * (1.0 / last_scale_ratio_ - 1.0));
+}
+
+void FeatureVo::scaleMap(const Eigen::Vector3d& c, double factor) {
+  for (MapPoint& mp : points_) mp.p_world = c + factor * (mp.p_world - c);
+  for (Frame& kf : keyframes_)
+    kf.T_world_cam.translation() = c + factor * (kf.T_world_cam.translation() - c);
   T_delta_.translation() *= factor;
+  scaled_since_ba_a_ *= factor;
+  scaled_since_ba_b_ = factor * scaled_since_ba_b_ + (1.0 - factor) * c;
+}
+
+std::vector<std::size_t> FeatureVo::covisibleKeyframes(std::size_t k) const {
+  std::vector<char> in_k(points_.size(), 0);
+  for (int id : keyframes_[k].point_of_feature)
+    if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad)
+      in_k[static_cast<std::size_t>(id)] = 1;
+  std::vector<std::pair<int, std::size_t>> shared;
+  for (std::size_t j = 0; j < keyframes_.size(); ++j) {
+    if (j == k) continue;
+    int n = 0;
+    for (int id : keyframes_[j].point_of_feature)
+      if (id >= 0 && in_k[static_cast<std::size_t>(id)] != 0) ++n;
+    if (n >= params_.min_covisible_points) shared.emplace_back(-n, j);
+  }
+  std::sort(shared.begin(), shared.end());
+  std::vector<std::size_t> out;
+  for (const auto& [n, j] : shared) out.push_back(j);
+  return out;
+}
+
+std::vector<int> FeatureVo::localMapPoints() const {
+  std::vector<int> ids;
+  for (const Frame& kf : keyframes_) {
+    if (!local_keyframe_ids_.empty() &&
+        std::find(local_keyframe_ids_.begin(), local_keyframe_ids_.end(), kf.id) ==
+            local_keyframe_ids_.end())
+      continue;
+    for (int id : kf.point_of_feature)
+      if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad) ids.push_back(id);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+
+void FeatureVo::fuseNewKeyframe(const cv::Matx33d& K, cv::Size image_size) {
+  if (params_.fuse_radius_px <= 0.0) return;
+  const std::size_t newest = keyframes_.size() - 1;
+  const std::vector<std::size_t> neighbours = covisibleKeyframes(newest);
+  std::vector<int> new_ids;
+  for (int id : keyframes_[newest].point_of_feature)
+    if (id >= 0) new_ids.push_back(id);
+  std::vector<std::pair<int, int>> merges;
+  std::vector<int> neighbour_ids;
+  for (std::size_t k : neighbours) {
+    fuseInto(keyframes_[k], new_ids, K, image_size, merges);
+    for (int id : keyframes_[k].point_of_feature)
+      if (id >= 0) neighbour_ids.push_back(id);
+  }
+  std::sort(neighbour_ids.begin(), neighbour_ids.end());
+  neighbour_ids.erase(std::unique(neighbour_ids.begin(), neighbour_ids.end()), neighbour_ids.end());
+  fuseInto(keyframes_[newest], neighbour_ids, K, image_size, merges);
+  mergePoints(merges);
+}
+
+void FeatureVo::fuseInto(Frame& target, const std::vector<int>& ids, const cv::Matx33d& K,
+                         cv::Size image_size, std::vector<std::pair<int, int>>& merges) {
+  std::set<int> in_target;
+  for (int id : target.point_of_feature)
+    if (id >= 0) in_target.insert(id);
+  std::vector<int> candidates;
+  for (int id : ids)
+    if (!points_[static_cast<std::size_t>(id)].bad && in_target.count(id) == 0)
+      candidates.push_back(id);
+  const ProjectedPoints projected =
+      projectPoints(candidates, target.T_world_cam, K, image_size, 0.0);
+  if (projected.ids.empty()) return;
+  const std::vector<cv::DMatch> matches = matchByWindow(
+      projected.features, target.features, projected.px, static_cast<float>(params_.fuse_radius_px),
+      params_.max_hamming, static_cast<float>(params_.match_ratio));
+  for (const cv::DMatch& m : matches) {
+    const int id = projected.ids[static_cast<std::size_t>(m.queryIdx)];
+    int& held = target.point_of_feature[static_cast<std::size_t>(m.trainIdx)];
+    if (held >= 0 && !points_[static_cast<std::size_t>(held)].bad) {
+      if (held != id) merges.emplace_back(held, id);
+      continue;
+    }
+    held = id;
+    ++points_[static_cast<std::size_t>(id)].keyframes_seen;
+    ++map_stats_.observations_fused;
+  }
+}
+
+void FeatureVo::mergePoints(const std::vector<std::pair<int, int>>& merges) {
+  if (merges.empty()) return;
+  // Each point merged into another names it; the one more key-frames see stays.
+  std::unordered_map<int, int> merged_into;
+  const auto root = [&merged_into](int id) {
+    for (auto it = merged_into.find(id); it != merged_into.end(); it = merged_into.find(id))
+      id = it->second;
+    return id;
+  };
+  for (const auto& [a_in, b_in] : merges) {
+    int a = root(a_in);
+    int b = root(b_in);
+    if (a == b) continue;
+    if (points_[static_cast<std::size_t>(a)].keyframes_seen <
+        points_[static_cast<std::size_t>(b)].keyframes_seen)
+      std::swap(a, b);
+    merged_into[b] = a;
+    points_[static_cast<std::size_t>(b)].bad = true;
+    ++map_stats_.points_merged;
+  }
+  for (Frame& kf : keyframes_) {
+    std::set<int> held;
+    for (int id : kf.point_of_feature)
+      if (id >= 0 && !merged_into.contains(id)) held.insert(id);
+    for (int& id : kf.point_of_feature) {
+      if (id < 0 || !merged_into.contains(id)) continue;
+      const int kept = root(id);
+      id = held.insert(kept).second ? kept : -1;
+      if (id >= 0) ++points_[static_cast<std::size_t>(id)].keyframes_seen;
+    }
+  }
+}
+
+void FeatureVo::cullNewPoints() {
+  for (MapPoint& mp : points_) {
+    if (mp.bad || mp.made_at_keyframe < 0) continue;
+    const std::int64_t age = keyframes_made_ - mp.made_at_keyframe;
+    if (static_cast<double>(mp.found) <
+            params_.point_min_found_ratio * static_cast<double>(mp.visible) ||
+        (age >= 2 && mp.keyframes_seen < params_.point_min_keyframes)) {
+      mp.bad = true;
+      ++map_stats_.points_culled;
+    } else if (age >= 3) {
+      mp.made_at_keyframe = -1;
+    }
+  }
 }
 
 int FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K) {
@@ -673,7 +843,8 @@ int FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::
     const int i_new = index_new[static_cast<std::size_t>(m.trainIdx)];
     MapPoint mp;
     mp.p_world = kf_prev.T_world_cam * t.p_1;
-    mp.keyframes_seen = 1;  // kf_prev, already in the window
+    mp.keyframes_seen = 2;
+    mp.made_at_keyframe = keyframes_made_;
     mp.descriptor = kf_new.features.descriptors.row(i_new).clone();
     const int id = static_cast<int>(points_.size());
     points_.push_back(std::move(mp));
@@ -686,18 +857,15 @@ int FeatureVo::triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::
 }
 
 void FeatureVo::triangulateNewPoints(Frame& kf_new, const cv::Matx33d& K) {
-  // Pair the new key-frame with the earlier ones that share its view, widest
-  // baseline first: in a turn, key-frames come every few degrees of rotation
-  // with a baseline too short for the parallax the neighbour alone would give.
-  std::set<int> new_ids;
-  for (int id : kf_new.point_of_feature)
-    if (id >= 0) new_ids.insert(id);
+  // Pair the new key-frame (the newest of the map) with its most co-visible
+  // ones, widest baseline first: in a turn, key-frames come every few degrees
+  // of rotation with a baseline too short for the parallax the neighbour alone
+  // would give.
+  std::vector<std::size_t> covisible = covisibleKeyframes(keyframes_.size() - 1);
+  if (covisible.size() > static_cast<std::size_t>(params_.local_window))
+    covisible.resize(static_cast<std::size_t>(params_.local_window));
   std::vector<std::pair<double, std::size_t>> candidates;
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    int shared = 0;
-    for (int id : keyframes_[k].point_of_feature)
-      if (id >= 0 && new_ids.count(id) != 0) ++shared;
-    if (shared < params_.min_tracked_points && k + 1 != keyframes_.size()) continue;
+  for (std::size_t k : covisible) {
     const double baseline_m =
         (keyframes_[k].T_world_cam.translation() - kf_new.T_world_cam.translation()).norm();
     candidates.emplace_back(-baseline_m, k);
@@ -718,52 +886,77 @@ struct FeatureVo::LocalBaJob {
   std::int64_t map_generation = 0;
   BaProblem problem;
   BaResult result;
-  std::vector<std::int64_t> keyframe_ids;      // of the problem's first cameras
-  std::vector<int> point_ids;                  // of the problem's points
-  std::vector<Eigen::Vector3d> points_before;  // their positions when the BA started
-  std::vector<Ref> refs;                       // of the problem's observations
+  std::vector<std::int64_t> keyframe_ids;  // of the problem's first cameras
+  std::vector<int> point_ids;              // of the problem's points
+  std::vector<Ref> refs;                   // of the problem's observations
 };
 
 bool FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
-  const int n = static_cast<int>(keyframes_.size());
+  const std::size_t n = keyframes_.size();
   if (n < 2) return false;
   if (params_.background_ba && pending_ba_.valid()) return false;
   auto job = std::make_unique<LocalBaJob>();
   job->map_generation = map_generation_;
   BaProblem& problem = job->problem;
   problem.K = baIntrinsics(K);
-  // Only the oldest key-frame is fixed: the scale stays free, so the range
-  // correction of the newest key-frame's points spreads instead of being pulled back.
-  const int fixed = std::min(1, n - 1);
-  for (int k = 0; k < n; ++k) {
-    const Frame& kf = keyframes_[static_cast<std::size_t>(k)];
-    problem.cameras.push_back({kf.T_world_cam, k < fixed});
-    job->keyframe_ids.push_back(kf.id);
-  }
+  // Optimised: the newest key-frame and its most co-visible ones. Held fixed:
+  // every other key-frame that sees their points, so that the map's attitude
+  // and scale come from all that saw it, not from the window alone.
+  std::vector<std::size_t> free_kfs = covisibleKeyframes(n - 1);
+  if (free_kfs.size() + 1 > static_cast<std::size_t>(params_.local_window))
+    free_kfs.resize(static_cast<std::size_t>(params_.local_window) - 1);
+  free_kfs.insert(free_kfs.begin(), n - 1);
+  std::vector<char> is_free(n, 0);
+  for (std::size_t k : free_kfs) is_free[k] = 1;
   std::unordered_map<int, int> ba_index;
-  for (int k = 0; k < n; ++k) {
-    const Frame& kf = keyframes_[static_cast<std::size_t>(k)];
-    for (std::size_t i = 0; i < kf.point_of_feature.size(); ++i) {
-      const int id = kf.point_of_feature[i];
-      if (id < 0 || points_[static_cast<std::size_t>(id)].bad) continue;
-      auto [it, inserted] = ba_index.emplace(id, static_cast<int>(job->point_ids.size()));
-      if (inserted) {
+  for (std::size_t k : free_kfs)
+    for (int id : keyframes_[k].point_of_feature)
+      if (id >= 0 && !points_[static_cast<std::size_t>(id)].bad &&
+          ba_index.emplace(id, static_cast<int>(job->point_ids.size())).second) {
         job->point_ids.push_back(id);
         problem.points.push_back({points_[static_cast<std::size_t>(id)].p_world, false});
       }
-      const cv::KeyPoint& kp = kf.features.keypoints[i];
-      problem.observations.push_back(
-          {k, it->second, Eigen::Vector2d(kp.pt.x, kp.pt.y),
-           std::pow(static_cast<double>(params_.features.scale_factor), kp.octave)});
-      job->refs.push_back({kf.id, i, id});
-    }
+  std::vector<std::size_t> fixed_kfs;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (is_free[k] != 0) continue;
+    for (int id : keyframes_[k].point_of_feature)
+      if (id >= 0 && ba_index.contains(id)) {
+        fixed_kfs.push_back(k);
+        break;
+      }
+  }
+  // Without an outer key-frame (a young map) the oldest of the window holds the gauge.
+  if (fixed_kfs.empty()) {
+    const auto oldest = std::min_element(free_kfs.begin(), free_kfs.end());
+    fixed_kfs.push_back(*oldest);
+    free_kfs.erase(oldest);
   }
   std::vector<const Frame*> frames;
-  for (const Frame& kf : keyframes_) frames.push_back(&kf);
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t k : pass == 0 ? free_kfs : fixed_kfs) {
+      const Frame& kf = keyframes_[k];
+      const int camera = static_cast<int>(problem.cameras.size());
+      problem.cameras.push_back({kf.T_world_cam, pass == 1});
+      job->keyframe_ids.push_back(kf.id);
+      if (pass == 0) frames.push_back(&kf);
+      for (std::size_t i = 0; i < kf.point_of_feature.size(); ++i) {
+        const int id = kf.point_of_feature[i];
+        if (id < 0) continue;
+        const auto it = ba_index.find(id);
+        if (it == ba_index.end() || points_[static_cast<std::size_t>(id)].bad) continue;
+        const cv::KeyPoint& kp = kf.features.keypoints[i];
+        problem.observations.push_back(
+            {camera, it->second, Eigen::Vector2d(kp.pt.x, kp.pt.y),
+             std::pow(static_cast<double>(params_.features.scale_factor), kp.octave)});
+        job->refs.push_back({kf.id, i, id});
+      }
+    }
   addAttitudePriors(problem, frames);
+  recordLocalBaShape(*job, free_kfs.size(), fixed_kfs.size());
   BundleAdjustmentParams ba = params_.ba;
   ba.num_threads = 1;
-  for (const BaPoint& point : problem.points) job->points_before.push_back(point.p_world_m);
+  scaled_since_ba_a_ = 1.0;
+  scaled_since_ba_b_.setZero();
   if (!params_.background_ba) {
     job->result = bundleAdjust(problem, ba);
     applyLocalBa(*job);
@@ -783,30 +976,54 @@ void FeatureVo::collectBackgroundBa(bool wait) {
   applyLocalBa(*job);
 }
 
+void FeatureVo::recordLocalBaShape(const LocalBaJob& job, std::size_t free_keyframes,
+                                   std::size_t fixed_keyframes) {
+  map_stats_.ba_free_keyframes = static_cast<int>(free_keyframes);
+  map_stats_.ba_fixed_keyframes = static_cast<int>(fixed_keyframes);
+  std::vector<int> in_ba(job.point_ids.size(), 0);
+  for (const BaObservation& o : job.problem.observations)
+    ++in_ba[static_cast<std::size_t>(o.point)];
+  std::unordered_map<int, int> in_map;
+  for (int id : job.point_ids) in_map.emplace(id, 0);
+  for (const Frame& kf : keyframes_)
+    for (int id : kf.point_of_feature)
+      if (const auto it = in_map.find(id); it != in_map.end()) ++it->second;
+  auto& bins = map_stats_.ba_points_by_observations;
+  std::fill(bins.begin(), bins.end(), 0);
+  map_stats_.ba_points_missing_observations = 0;
+  for (std::size_t j = 0; j < job.point_ids.size(); ++j) {
+    ++bins[std::min(static_cast<std::size_t>(in_ba[j]), bins.size() - 1)];
+    if (in_map.at(job.point_ids[j]) > in_ba[j]) ++map_stats_.ba_points_missing_observations;
+  }
+}
+
 void FeatureVo::applyLocalBa(const LocalBaJob& job) {
   // A map dropped since the BA started is gone; key-frames that left the
   // window since keep their place (the deque holds them by age).
   if (job.map_generation != map_generation_) return;
+  // The map may have been scaled since the BA started (in the background):
+  // its result is scaled alike.
+  const double a = scaled_since_ba_a_;
+  const Eigen::Vector3d& b = scaled_since_ba_b_;
   std::unordered_map<std::int64_t, Frame*> by_id;
   for (Frame& kf : keyframes_) by_id.emplace(kf.id, &kf);
   for (std::size_t k = 0; k < job.keyframe_ids.size(); ++k) {
     const auto it = by_id.find(job.keyframe_ids[k]);
-    if (it != by_id.end()) it->second->T_world_cam = job.problem.cameras[k].T_world_cam;
+    if (it == by_id.end() || job.problem.cameras[k].fixed) continue;
+    it->second->T_world_cam = job.problem.cameras[k].T_world_cam;
+    it->second->T_world_cam.translation() = a * it->second->T_world_cam.translation() + b;
   }
-  // In the background, points take the BA's correction, not its positions: a
-  // range correction may have moved them since the BA started.
-  for (std::size_t j = 0; j < job.point_ids.size(); ++j) {
-    Eigen::Vector3d& p = points_[static_cast<std::size_t>(job.point_ids[j])].p_world;
-    p = params_.background_ba
-            ? Eigen::Vector3d(p + job.problem.points[j].p_world_m - job.points_before[j])
-            : job.problem.points[j].p_world_m;
-  }
+  for (std::size_t j = 0; j < job.point_ids.size(); ++j)
+    points_[static_cast<std::size_t>(job.point_ids[j])].p_world =
+        a * job.problem.points[j].p_world_m + b;
   for (std::size_t o = 0; o < job.refs.size(); ++o) {
     if (!job.result.outlier[o]) continue;
     const auto it = by_id.find(job.refs[o].keyframe_id);
     if (it == by_id.end()) continue;
     int& point = it->second->point_of_feature[job.refs[o].feature];
-    if (point == job.refs[o].point_id) point = -1;
+    if (point != job.refs[o].point_id) continue;
+    point = -1;
+    --points_[static_cast<std::size_t>(job.refs[o].point_id)].keyframes_seen;
   }
 }
 

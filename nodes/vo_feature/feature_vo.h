@@ -39,11 +39,24 @@ struct FeatureVoParams {
   double keyframe_min_shared_ratio = 0.8;
   // New key-frame when the rotation since the last key-frame exceeds this, deg.
   double keyframe_max_rotation_deg = 5.0;
-  // Key-frames in the local bundle adjustment.
+  // Key-frames the local bundle adjustment optimises: the new one and its most
+  // co-visible ones (the others that see their points are held fixed).
   int local_window = 8;
-  // A new key-frame triangulates with this many earlier key-frames sharing its
-  // view, widest baseline first.
-  int triangulation_keyframes = 1;
+  // Key-frames the map keeps (the oldest is dropped beyond this).
+  int map_keyframes = 16;
+  // Two key-frames are co-visible when they share at least this many points.
+  int min_covisible_points = 15;
+  // A new key-frame triangulates with this many co-visible key-frames, widest
+  // baseline first.
+  int triangulation_keyframes = 3;
+  // Fusion: a point projected into a co-visible key-frame takes the feature
+  // within this many pixels of its projection whose descriptor matches.
+  double fuse_radius_px = 4.0;
+  // A new point is dropped when tracking found it in fewer than this share of
+  // the frames it was in view of, or when fewer than point_min_keyframes
+  // key-frames see it two key-frames after it was made.
+  double point_min_found_ratio = 0.25;
+  int point_min_keyframes = 3;
   // Local bundle adjustment every this many key-frames.
   int ba_every_keyframes = 1;
   // Live: the local bundle adjustment runs in a background thread and its
@@ -107,6 +120,18 @@ struct FeatureVoMapStats {
   // points_by_keyframes[k]: points seen by k key-frames (the last bin: that many or more).
   std::vector<std::int64_t> points_by_keyframes = std::vector<std::int64_t>(33, 0);
   std::int64_t points_dropped = 0;
+  // Observations fusion added, points it merged into another, new points culled.
+  std::int64_t observations_fused = 0;
+  std::int64_t points_merged = 0;
+  std::int64_t points_culled = 0;
+  // The last local BA: the key-frames it optimised and held fixed, its points
+  // by the observations they entered it with (the last bin: that many or more),
+  // and its points that some key-frame of the map saw without that
+  // observation in the BA (none: each point is optimised against all that saw it).
+  int ba_free_keyframes = 0;
+  int ba_fixed_keyframes = 0;
+  std::vector<std::int64_t> ba_points_by_observations = std::vector<std::int64_t>(33, 0);
+  std::int64_t ba_points_missing_observations = 0;
 };
 
 struct VoFrameOutput {
@@ -134,7 +159,7 @@ class FeatureVo {
   VoFrameOutput process(const VoFrameInput& frame);
 
   // Diagnostics: map range / measured range at the last key-frame with a
-  // range (1 before), key-frames in the window and map points alive.
+  // range (1 before), key-frames in the map and map points alive.
   double lastScaleRatio() const { return last_scale_ratio_; }
   int numKeyframes() const { return static_cast<int>(keyframes_.size()); }
   int numMapPoints() const;
@@ -151,6 +176,11 @@ class FeatureVo {
     cv::Mat descriptor;  // 1 x 32, CV_8U
     bool bad = false;
     int keyframes_seen = 0;  // key-frames that have observed it
+    // Frames tracking expected it in view, and found it (culling).
+    int visible = 1;
+    int found = 1;
+    // The key-frame count when it was made; -1: past the culling.
+    std::int64_t made_at_keyframe = -1;
   };
   struct Frame {
     Features features;
@@ -172,9 +202,33 @@ class FeatureVo {
   VoFrameOutput initialise(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_body_cam,
                            const Eigen::Isometry3d& T_pred);
   bool track(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred);
+  // Map points as a camera at T_world_cam sees them: those in front of it
+  // whose projection is within margin_px of the image (in_image: inside it),
+  // as features at their projections with the points' descriptors.
+  struct ProjectedPoints {
+    Features features;
+    std::vector<cv::Point2f> px;
+    std::vector<int> ids;
+    std::vector<char> in_image;
+  };
+  ProjectedPoints projectPoints(const std::vector<int>& ids, const Eigen::Isometry3d& T_world_cam,
+                                const cv::Matx33d& K, cv::Size image_size, double margin_px) const;
   int trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
                       double radius_px);
   void addKeyframe(const Frame& cur, const VoFrameInput& in);
+  // Indices into keyframes_ of the key-frames sharing at least
+  // min_covisible_points points with keyframes_[k], most shared first.
+  std::vector<std::size_t> covisibleKeyframes(std::size_t k) const;
+  // The points of the local map: those of the newest key-frame's co-visible ones.
+  std::vector<int> localMapPoints() const;
+  // Fusion of the newest key-frame with its co-visible key-frames (both ways).
+  void fuseNewKeyframe(const cv::Matx33d& K, cv::Size image_size);
+  void fuseInto(Frame& target, const std::vector<int>& ids, const cv::Matx33d& K,
+                cv::Size image_size, std::vector<std::pair<int, int>>& merges);
+  void mergePoints(const std::vector<std::pair<int, int>>& merges);
+  void cullNewPoints();
+  // p -> c + factor (p - c) for every point and key-frame centre of the map.
+  void scaleMap(const Eigen::Vector3d& c, double factor);
   VoFrameOutput output(VoStatus status, const Eigen::Isometry3d& T_world_cam,
                        const Eigen::Isometry3d& T_body_cam, int tracked, bool keyframe) const;
   // Returns the points added.
@@ -184,6 +238,8 @@ class FeatureVo {
   // Starts (or, not in the background, runs) a local BA; false if none started.
   bool localBundleAdjust(const cv::Matx33d& K);
   void applyLocalBa(const LocalBaJob& job);
+  void recordLocalBaShape(const LocalBaJob& job, std::size_t free_keyframes,
+                          std::size_t fixed_keyframes);
   void collectBackgroundBa(bool wait);
   // The map's range along the rangefinder's ray from a camera (see the top).
   std::optional<double> mapRange(const std::vector<Eigen::Vector3d>& p_cam,
@@ -208,6 +264,12 @@ class FeatureVo {
 
   std::vector<MapPoint> points_;
   std::deque<Frame> keyframes_;
+  std::int64_t keyframes_made_ = 0;
+  // The newest key-frame and its co-visible ones (their ids): the local map tracking uses.
+  std::vector<std::int64_t> local_keyframe_ids_;
+  // The map's scaling since the background BA started, p -> a p + b.
+  double scaled_since_ba_a_ = 1.0;
+  Eigen::Vector3d scaled_since_ba_b_ = Eigen::Vector3d::Zero();
   int keyframes_since_ba_ = 0;
   // The most of the last key-frame's points a frame since it has tracked.
   int keyframe_peak_shared_ = 0;
