@@ -486,10 +486,13 @@ VoFrameOutput FeatureVo::initialise(Frame& cur, const VoFrameInput& in,
 }
 
 bool FeatureVo::track(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred) {
-  if (trackWithRadius(cur, in, T_pred, params_.track_radius_px) >= params_.min_tracked_points)
+  const std::vector<int> ids = localMapPoints();
+  if (trackWithRadius(cur, in, T_pred, ids, params_.track_radius_px, true) >=
+      params_.min_tracked_points)
     return true;
   std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
-  if (trackWithRadius(cur, in, T_pred, params_.track_wide_radius_px) >= params_.min_tracked_points)
+  if (trackWithRadius(cur, in, T_pred, ids, params_.track_wide_radius_px, false) >=
+      params_.min_tracked_points)
     return true;
   std::fill(cur.point_of_feature.begin(), cur.point_of_feature.end(), -1);
   return false;
@@ -523,10 +526,9 @@ FeatureVo::ProjectedPoints FeatureVo::projectPoints(const std::vector<int>& ids,
 }
 
 int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
-                               double radius_px) {
-  const std::vector<int> ids = localMapPoints();
+                               const std::vector<int>& ids, double radius_px, bool count_visible) {
   const ProjectedPoints local = projectPoints(ids, T_pred, in.K, in.gray.size(), radius_px);
-  if (radius_px == params_.track_radius_px)
+  if (count_visible)
     for (std::size_t j = 0; j < local.ids.size(); ++j)
       if (local.in_image[j] != 0) ++points_[static_cast<std::size_t>(local.ids[j])].visible;
   if (static_cast<int>(local.ids.size()) < params_.min_tracked_points) return 0;
@@ -621,10 +623,10 @@ void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   cullNewPoints();
   while (static_cast<int>(keyframes_.size()) > params_.map_keyframes) keyframes_.pop_front();
   compactMap();
+  const std::vector<std::size_t> covisible = covisibleKeyframes(keyframes_.size() - 1);
   local_keyframe_ids_ = {keyframes_.back().id};
-  for (std::size_t k : covisibleKeyframes(keyframes_.size() - 1))
-    local_keyframe_ids_.push_back(keyframes_[k].id);
-  if (++keyframes_since_ba_ >= params_.ba_every_keyframes && localBundleAdjust(in.K))
+  for (std::size_t k : covisible) local_keyframe_ids_.push_back(keyframes_[k].id);
+  if (++keyframes_since_ba_ >= params_.ba_every_keyframes && localBundleAdjust(in.K, covisible))
     keyframes_since_ba_ = 0;
   if (!in.range_m) return;
   const Frame& newest = keyframes_.back();
@@ -891,7 +893,7 @@ struct FeatureVo::LocalBaJob {
   std::vector<Ref> refs;                   // of the problem's observations
 };
 
-bool FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
+bool FeatureVo::localBundleAdjust(const cv::Matx33d& K, const std::vector<std::size_t>& covisible) {
   const std::size_t n = keyframes_.size();
   if (n < 2) return false;
   if (params_.background_ba && pending_ba_.valid()) return false;
@@ -902,7 +904,7 @@ bool FeatureVo::localBundleAdjust(const cv::Matx33d& K) {
   // Optimised: the newest key-frame and its most co-visible ones. Held fixed:
   // every other key-frame that sees their points, so that the map's attitude
   // and scale come from all that saw it, not from the window alone.
-  std::vector<std::size_t> free_kfs = covisibleKeyframes(n - 1);
+  std::vector<std::size_t> free_kfs = covisible;
   if (free_kfs.size() + 1 > static_cast<std::size_t>(params_.local_window))
     free_kfs.resize(static_cast<std::size_t>(params_.local_window) - 1);
   free_kfs.insert(free_kfs.begin(), n - 1);

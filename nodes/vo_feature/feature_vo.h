@@ -213,8 +213,10 @@ class FeatureVo {
   };
   ProjectedPoints projectPoints(const std::vector<int>& ids, const Eigen::Isometry3d& T_world_cam,
                                 const cv::Matx33d& K, cv::Size image_size, double margin_px) const;
+  // Matches the map points ids within radius_px of their predicted pixels;
+  // count_visible: the first try of a frame counts the points in view (culling).
   int trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::Isometry3d& T_pred,
-                      double radius_px);
+                      const std::vector<int>& ids, double radius_px, bool count_visible);
   void addKeyframe(const Frame& cur, const VoFrameInput& in);
   // Indices into keyframes_ of the key-frames sharing at least
   // min_covisible_points points with keyframes_[k], most shared first.
@@ -235,8 +237,9 @@ class FeatureVo {
   int triangulateWithPrevious(Frame& kf_new, Frame& kf_prev, const cv::Matx33d& K);
   void triangulateNewPoints(Frame& kf_new, const cv::Matx33d& K);
   struct LocalBaJob;
-  // Starts (or, not in the background, runs) a local BA; false if none started.
-  bool localBundleAdjust(const cv::Matx33d& K);
+  // Starts (or, not in the background, runs) a local BA over the newest
+  // key-frame and the co-visible ones (covisibleKeyframes of it); false if none started.
+  bool localBundleAdjust(const cv::Matx33d& K, const std::vector<std::size_t>& covisible);
   void applyLocalBa(const LocalBaJob& job);
   void recordLocalBaShape(const LocalBaJob& job, std::size_t free_keyframes,
                           std::size_t fixed_keyframes);
