@@ -1,5 +1,8 @@
 #include "nodes/common/flight_inputs.h"
 
+#include <algorithm>
+#include <iterator>
+
 #include "lcmtypes/bus_io.h"
 
 namespace nadir::nodes {
@@ -7,13 +10,18 @@ namespace {
 
 // Enough for a 200 Hz attitude stream to cover the frames a slow node is behind.
 constexpr std::size_t kAttitudeHistory = 64;
+// The same for a 50 Hz rangefinder.
+constexpr std::size_t kRangeHistory = 32;
 
 }  // namespace
 
 FlightInputs::FlightInputs(core::Bus& bus, const std::string& range_channel,
                            const std::string& attitude_channel) {
-  subscriptions_.push_back(msg::subscribe<msg::Range>(
-      bus, range_channel, [this](const msg::Range& range) { range_ = range; }));
+  subscriptions_.push_back(
+      msg::subscribe<msg::Range>(bus, range_channel, [this](const msg::Range& range) {
+        ranges_.push_back(range);
+        if (ranges_.size() > kRangeHistory) ranges_.pop_front();
+      }));
   subscriptions_.push_back(
       msg::subscribe<msg::Attitude>(bus, attitude_channel, [this](const msg::Attitude& attitude) {
         attitudes_.push_back(attitude);
@@ -21,9 +29,18 @@ FlightInputs::FlightInputs(core::Bus& bus, const std::string& range_channel,
       }));
 }
 
-std::optional<double> FlightInputs::validRange_m() const {
-  if (!range_ || range_->status != msg::RangeStatus::VALID) return std::nullopt;
-  return range_->range_m;
+std::optional<double> FlightInputs::rangeAt_m(std::int64_t utime) const {
+  const auto valid = [](const msg::Range& r) { return r.status == msg::RangeStatus::VALID; };
+  const auto after = std::find_if(ranges_.begin(), ranges_.end(),
+                                  [utime](const msg::Range& r) { return r.utime > utime; });
+  if (after == ranges_.begin()) return std::nullopt;
+  const msg::Range& before = *std::prev(after);
+  if (!valid(before)) return std::nullopt;
+  if (after == ranges_.end()) return before.range_m;
+  if (!valid(*after)) return std::nullopt;
+  const double s =
+      static_cast<double>(utime - before.utime) / static_cast<double>(after->utime - before.utime);
+  return before.range_m + s * (after->range_m - before.range_m);
 }
 
 std::optional<Eigen::Quaterniond> FlightInputs::attitudeAt(std::int64_t utime) const {

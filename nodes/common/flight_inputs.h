@@ -1,6 +1,6 @@
 #pragma once
 // What VO nodes read from the flight stack besides images, kept current from
-// the bus: the latest rangefinder reading and a short history of the flight
+// the bus: short histories of the rangefinder's readings and of the flight
 // controller's attitude, looked up at an image's time.
 
 #include <deque>
@@ -20,13 +20,17 @@ class FlightInputs {
   FlightInputs(core::Bus& bus, const std::string& range_channel,
                const std::string& attitude_channel);
 
-  // The latest VALID range, m; nothing before one or when the latest is not valid.
-  std::optional<double> validRange_m() const;
+  // The range at utime, m: interpolated between the readings just before and
+  // just after it when both are VALID, else the one at or before it when that
+  // is the latest and VALID; nothing otherwise. An image is stamped at its
+  // exposure and arrives after later readings: in a banked turn the slant
+  // range changes by metres between two of them.
+  std::optional<double> rangeAt_m(std::int64_t utime) const;
   // The attitude at or just before utime (R_world_body); nothing if none is that old.
   std::optional<Eigen::Quaterniond> attitudeAt(std::int64_t utime) const;
 
  private:
-  std::optional<msg::Range> range_;
+  std::deque<msg::Range> ranges_;
   std::deque<msg::Attitude> attitudes_;
   std::vector<core::Subscription> subscriptions_;
 };

@@ -68,7 +68,7 @@ std::variant<vo::VoFrameInput, std::string> VoFrameSource::frame(const msg::Imag
   input.R_body_cam = info_->q_body_cam.toRotationMatrix();
   input.readout_s = info_->readout_s;
   // The rangefinder looks along the body's down axis.
-  input.range_m = inputs_.validRange_m();
+  input.range_m = inputs_.rangeAt_m(image.utime);
   input.range_ray_cam = input.R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
   if (attitude_prior) input.q_world_body_prior = inputs_.attitudeAt(image.utime);
   return input;

@@ -146,7 +146,7 @@ void PpaNode::onImage(const msg::Image& image) {
   input.alignment = {
       vo.translation_x_px, vo.translation_y_px, vo.rotation_rad,        vo.scale,
       vo.strength,         vo.new_keyframe,     vo.keyframe_edge_count, vo.edge_count};
-  input.range_m = inputs_.validRange_m();
+  input.range_m = inputs_.rangeAt_m(image.utime);
   input.q_world_body = q_world_body;
   // Only a target wholly in view corrects the position: a box cut by the
   // image's border has a shifted centre.

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "nodes/common/rolling_shutter.h"
+#include "nodes/vo_feature/map_range.h"
 
 namespace nadir::vo {
 namespace {
@@ -591,17 +592,18 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
 
 std::optional<double> FeatureVo::mapRange(const std::vector<Eigen::Vector3d>& p_cam,
                                           const VoFrameInput& in) const {
-  const Eigen::Vector3d& ray = in.range_ray_cam;
+  const Eigen::Vector3d ray = in.range_ray_cam.normalized();
   if (!(ray.z() > 1e-6)) return std::nullopt;
   const Eigen::Vector2d ray_px = project(in.K, ray);
   // The window grows until it holds enough points (a sparse patch under the ray).
   for (double window_px = params_.range_window_px; window_px <= 4.0 * params_.range_window_px;
        window_px *= 2.0) {
-    std::vector<double> ranges;
+    std::vector<Eigen::Vector3d> near;
     for (const Eigen::Vector3d& p : p_cam)
-      if (p.z() > 0.0 && (project(in.K, p) - ray_px).norm() <= window_px)
-        ranges.push_back(p.dot(ray));
-    if (ranges.size() >= 10) return median(ranges);
+      if (p.z() > 0.0 && (project(in.K, p) - ray_px).norm() <= window_px) near.push_back(p);
+    if (near.size() < kMinPlanePoints) continue;
+    if (const std::optional<double> range = rangeToPlaneAlongRay(std::move(near), ray))
+      return range;
   }
   return std::nullopt;
 }
