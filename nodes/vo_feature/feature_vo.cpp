@@ -560,6 +560,23 @@ int FeatureVo::trackWithRadius(Frame& cur, const VoFrameInput& in, const Eigen::
   Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
   T_cw.linear() = R_cam_world;
   T_cw.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  // OpenCV refits the RANSAC pose to all its inliers (EPnP after AP3P), and on
+  // the near-planar ground that refit often leaves most of them outside the
+  // threshold (once 480 m off, which lost the frame). The BA starts from
+  // whichever of it and the prediction explains more of the inliers.
+  const auto consistent = [&](const Eigen::Isometry3d& T_cam_world) {
+    int count = 0;
+    for (int i : inliers) {
+      const cv::Point3d& o = object[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d p_cam = T_cam_world * Eigen::Vector3d(o.x, o.y, o.z);
+      const cv::Point2d& px = image[static_cast<std::size_t>(i)];
+      if (p_cam.z() > 0.0 && (project(in.K, p_cam) - Eigen::Vector2d(px.x, px.y)).norm() <=
+                                 params_.pnp_reprojection_px)
+        ++count;
+    }
+    return count;
+  };
+  if (consistent(T_pred.inverse()) > consistent(T_cw)) T_cw = T_pred.inverse();
 
   // Motion-only bundle adjustment on the RANSAC inliers: the points stay fixed.
   BaProblem problem;
