@@ -619,8 +619,7 @@ std::optional<double> FeatureVo::mapRange(const std::vector<Eigen::Vector3d>& p_
     for (const Eigen::Vector3d& p : p_cam)
       if (p.z() > 0.0 && (project(in.K, p) - ray_px).norm() <= window_px) near.push_back(p);
     if (near.size() < kMinPlanePoints) continue;
-    if (const std::optional<double> range = rangeToPlaneAlongRay(std::move(near), ray))
-      return range;
+    if (const std::optional<double> range = rangeToPlaneAlongRay(near, ray)) return range;
   }
   return std::nullopt;
 }

@@ -7,40 +7,58 @@
 
 namespace nadir::vo {
 
-std::optional<double> rangeToPlaneAlongRay(std::vector<Eigen::Vector3d> points,
+namespace {
+
+// Below this |normal . ray| the plane is seen too nearly edge-on for a range.
+constexpr double kMinNormalAlongRay = 0.2;
+
+struct Plane {
+  Eigen::Vector3d centroid;
+  Eigen::Vector3d normal;
+};
+
+// Least squares: through the centroid, the normal the direction of least
+// spread (the eigenvalues ascend).
+Plane fitPlane(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) centroid += p;
+  centroid /= static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) scatter += (p - centroid) * (p - centroid).transpose();
+  return {centroid, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0)};
+}
+
+}  // namespace
+
+std::optional<double> rangeToPlaneAlongRay(const std::vector<Eigen::Vector3d>& points,
                                            const Eigen::Vector3d& ray) {
+  if (points.size() < kMinPlanePoints) return std::nullopt;
   const Eigen::Vector3d unit_ray = ray.normalized();
-  for (int pass = 0; pass < 2; ++pass) {
-    if (points.size() < kMinPlanePoints) return std::nullopt;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : points) centroid += p;
-    centroid /= static_cast<double>(points.size());
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (const Eigen::Vector3d& p : points) scatter += (p - centroid) * (p - centroid).transpose();
-    // The normal is the direction of least spread (the eigenvalues ascend).
-    const Eigen::Vector3d normal =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
-    const double along = normal.dot(unit_ray);
-    if (std::abs(along) < 0.2) return std::nullopt;
-    if (pass == 1) {
-      const double range = normal.dot(centroid) / along;
-      if (!(range > 0.0)) return std::nullopt;
-      return range;
-    }
-    std::vector<double> distance;
-    distance.reserve(points.size());
-    for (const Eigen::Vector3d& p : points) distance.push_back(std::abs(normal.dot(p - centroid)));
-    std::vector<double> sorted = distance;
-    std::nth_element(sorted.begin(),
-                     sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    // 1.4826 MAD is a Gaussian's sigma; the floor keeps an exact plane's points.
-    const double limit = std::max(3.0 * 1.4826 * sorted[sorted.size() / 2], 1e-6 * centroid.norm());
-    std::vector<Eigen::Vector3d> kept;
-    for (std::size_t i = 0; i < points.size(); ++i)
-      if (distance[i] <= limit) kept.push_back(points[i]);
-    points = std::move(kept);
-  }
-  return std::nullopt;
+  const Plane first = fitPlane(points);
+  if (std::abs(first.normal.dot(unit_ray)) < kMinNormalAlongRay) return std::nullopt;
+
+  // Again without the points more than 3 robust sigmas off the first plane.
+  std::vector<double> distance;
+  distance.reserve(points.size());
+  for (const Eigen::Vector3d& p : points)
+    distance.push_back(std::abs(first.normal.dot(p - first.centroid)));
+  std::vector<double> sorted = distance;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                   sorted.end());
+  // 1.4826 MAD is a Gaussian's sigma; the floor keeps an exact plane's points.
+  const double limit =
+      std::max(3.0 * 1.4826 * sorted[sorted.size() / 2], 1e-6 * first.centroid.norm());
+  std::vector<Eigen::Vector3d> kept;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (distance[i] <= limit) kept.push_back(points[i]);
+  if (kept.size() < kMinPlanePoints) return std::nullopt;
+
+  const Plane plane = fitPlane(kept);
+  const double along = plane.normal.dot(unit_ray);
+  if (std::abs(along) < kMinNormalAlongRay) return std::nullopt;
+  const double range = plane.normal.dot(plane.centroid) / along;
+  if (!(range > 0.0)) return std::nullopt;
+  return range;
 }
 
 }  // namespace nadir::vo

@@ -19,7 +19,7 @@ inline constexpr std::size_t kMinPlanePoints = 10;
 // one behind. Unlike the points' median range along the ray, it is not biased
 // when the points lie on one side of the ray, as in a bank that turns the view
 // onto ground the map has not reached yet.
-std::optional<double> rangeToPlaneAlongRay(std::vector<Eigen::Vector3d> points,
+std::optional<double> rangeToPlaneAlongRay(const std::vector<Eigen::Vector3d>& points,
                                            const Eigen::Vector3d& ray);
 
 }  // namespace nadir::vo
