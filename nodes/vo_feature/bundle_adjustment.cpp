@@ -1,14 +1,15 @@
 #include "nodes/vo_feature/bundle_adjustment.h"
 
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <memory>
+#include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace nadir::vo {
@@ -28,95 +29,475 @@ void BundleAdjustmentParams::visit(core::ParamVisitor& v) {
           {.doc = "re-solves without the flagged outliers, repeated while the flags change",
            .min = 0,
            .max = 10});
-  v.field(
-      "num_threads", &num_threads,
-      {.doc = "solver threads (1 gives bit-identical results between runs)", .min = 1, .max = 256});
+  v.field("num_threads", &num_threads,
+          {.doc = "threads evaluating the residuals and their Jacobians (the result does not "
+                  "depend on them)",
+           .min = 1,
+           .max = 256});
 }
 
 namespace {
 
-// A camera's parameter blocks: R_world_cam as an Eigen quaternion (x, y, z, w)
-// and the camera centre in the world frame, m.
-struct CameraBlocks {
-  std::array<double, 4> q_world_cam{};
-  std::array<double, 3> p_world_cam_m{};
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat26 = Eigen::Matrix<double, 2, 6>;
+using Mat23 = Eigen::Matrix<double, 2, 3>;
+using Mat63 = Eigen::Matrix<double, 6, 3>;
+
+struct CameraState {
+  Eigen::Quaterniond q_world_cam = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p_world_cam_m = Eigen::Vector3d::Zero();
 };
 
-// The whitened reprojection error of one observation.
-class ReprojectionCost {
- public:
-  ReprojectionCost(const BaIntrinsics& K, const Eigen::Vector2d& px, double sigma_px)
-      : K_(K), px_(px), inv_sigma_(1.0 / sigma_px) {}
+// The cameras and points one call refines, written back at the end.
+struct State {
+  std::vector<CameraState> cameras;
+  std::vector<Eigen::Vector3d> points;
+};
 
-  template <typename T>
-  bool operator()(const T* q_world_cam, const T* p_world_cam_m, const T* p_world_m,
-                  T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_world_cam);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> centre(p_world_cam_m);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> point(p_world_m);
-    const Eigen::Matrix<T, 3, 1> p_cam = q.conjugate() * (point - centre);
-    if (!(p_cam.z() > T(0))) {
-      return false;  // behind the camera: Ceres rejects the step
+Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
+  Eigen::Matrix3d m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
+}
+
+Eigen::Quaterniond expMap(const Eigen::Vector3d& rotation_vector) {
+  const double angle = rotation_vector.norm();
+  if (angle < 1e-12) {
+    return Eigen::Quaterniond(1.0, 0.5 * rotation_vector.x(), 0.5 * rotation_vector.y(),
+                              0.5 * rotation_vector.z())
+        .normalized();
+  }
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, rotation_vector / angle));
+}
+
+Eigen::Vector3d logMap(Eigen::Quaterniond q) {
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  const double n = q.vec().norm();
+  if (n < 1e-12) return 2.0 * q.vec();
+  return 2.0 * std::atan2(n, q.w()) * q.vec() / n;
+}
+
+// The inverse of SO(3)'s right Jacobian at phi.
+Eigen::Matrix3d rightJacobianInverse(const Eigen::Vector3d& phi) {
+  const double angle = phi.norm();
+  const Eigen::Matrix3d s = skew(phi);
+  if (angle < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * s;
+  const double c =
+      1.0 / (angle * angle) - (1.0 + std::cos(angle)) / (2.0 * angle * std::sin(angle));
+  return Eigen::Matrix3d::Identity() + 0.5 * s + c * s * s;
+}
+
+// A rotation prior's whitened error, the rotation vector of
+// R_ab_prior^T R_a^T R_b in a's axes over its sigmas, and its Jacobians with
+// respect to rotations applied on each camera's side.
+struct PriorTerm {
+  Eigen::Vector3d error = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d d_a = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d d_b = Eigen::Matrix3d::Zero();
+};
+
+PriorTerm priorTerm(const BaRotationPrior& prior, const CameraState& a, const CameraState& b) {
+  const Eigen::Quaterniond R_ab_prior = prior.R_ab.normalized();
+  const Eigen::Matrix3d M = (a.q_world_cam.conjugate() * b.q_world_cam).toRotationMatrix();
+  const Eigen::Vector3d phi =
+      logMap(R_ab_prior.conjugate() * a.q_world_cam.conjugate() * b.q_world_cam);
+  const double sigma_z =
+      prior.sigma_about_a_z_rad > 0.0 ? prior.sigma_about_a_z_rad : prior.sigma_rad;
+  const Eigen::Matrix3d A =
+      Eigen::Vector3d(1.0 / prior.sigma_rad, 1.0 / prior.sigma_rad, 1.0 / sigma_z).asDiagonal() *
+      R_ab_prior.toRotationMatrix();
+  // E = R_prior^T R_a^T R_b: with R_b Exp(d), E Exp(d); with R_a Exp(d), E Exp(-M^T d).
+  const Eigen::Matrix3d J = A * rightJacobianInverse(phi);
+  return {A * phi, -J * M.transpose(), J};
+}
+
+// Ceres' convention: the cost of a residual r is rho(|r|^2) / 2 with Huber's
+// rho(s) = s up to k^2 and 2 k sqrt(s) - k^2 beyond.
+double huberRho(double s, double k) {
+  return k <= 0.0 || s <= k * k ? s : 2.0 * k * std::sqrt(s) - k * k;
+}
+
+// rho'(s), the weight of the residual in the normal equations.
+double huberWeight(double s, double k) { return k <= 0.0 || s <= k * k ? 1.0 : k / std::sqrt(s); }
+
+// Runs fn(begin, end) over [0, n) in up to `threads` contiguous chunks, the
+// first on this thread.
+template <typename Fn>
+void forChunks(std::size_t n, int threads, const Fn& fn) {
+  const std::size_t chunks = std::min<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)),
+                                                   std::max<std::size_t>(n / 256, 1));
+  if (chunks <= 1) {
+    fn(std::size_t{0}, n);
+    return;
+  }
+  std::vector<std::thread> workers;
+  for (std::size_t c = 1; c < chunks; ++c)
+    workers.emplace_back([&fn, n, c, chunks] { fn(n * c / chunks, n * (c + 1) / chunks); });
+  fn(std::size_t{0}, n / chunks);
+  for (std::thread& t : workers) t.join();
+}
+
+struct PassReport {
+  bool converged = true;
+  int iterations = 0;
+  std::string summary = "nothing to adjust";
+};
+
+// One Levenberg-Marquardt solve over the active observations and the priors
+// (the reduced camera system by the Schur complement of the points, dense),
+// in place on state.
+class LmPass {
+ public:
+  LmPass(const BaProblem& problem, const BundleAdjustmentParams& params,
+         const std::vector<bool>& active, State& state)
+      : problem_(problem), params_(params), state_(state) {
+    const std::size_t num_cameras = problem.cameras.size();
+    std::vector<bool> camera_used(num_cameras, false);
+    std::vector<bool> point_used(problem.points.size(), false);
+    for (std::size_t i = 0; i < problem.observations.size(); ++i) {
+      if (!active[i]) continue;
+      const BaObservation& obs = problem.observations[i];
+      obs_.push_back(static_cast<int>(i));
+      camera_used[obs.camera] = true;
+      point_used[obs.point] = true;
     }
-    residual[0] = (T(K_.fx) * p_cam.x() / p_cam.z() + T(K_.cx) - T(px_.x())) * T(inv_sigma_);
-    residual[1] = (T(K_.fy) * p_cam.y() / p_cam.z() + T(K_.cy) - T(px_.y())) * T(inv_sigma_);
-    return true;
+    for (std::size_t i = 0; i < problem.rotation_priors.size(); ++i) {
+      const BaRotationPrior& prior = problem.rotation_priors[i];
+      if (!problem.cameras[prior.camera_a].fixed || !problem.cameras[prior.camera_b].fixed) {
+        priors_.push_back(static_cast<int>(i));
+        camera_used[prior.camera_a] = camera_used[prior.camera_b] = true;
+      }
+    }
+    camera_var_.assign(num_cameras, -1);
+    for (std::size_t i = 0; i < num_cameras; ++i)
+      if (camera_used[i] && !problem.cameras[i].fixed) camera_var_[i] = num_free_cameras_++;
+    point_var_.assign(problem.points.size(), -1);
+    for (std::size_t j = 0; j < point_used.size(); ++j)
+      if (point_used[j] && !problem.points[j].fixed) point_var_[j] = num_free_points_++;
+    // The observations of each free point, for the Schur complement.
+    point_obs_begin_.assign(static_cast<std::size_t>(num_free_points_) + 1, 0);
+    for (int o : obs_) {
+      const int m = point_var_[problem.observations[o].point];
+      if (m >= 0) ++point_obs_begin_[static_cast<std::size_t>(m) + 1];
+    }
+    for (std::size_t m = 0; m < static_cast<std::size_t>(num_free_points_); ++m)
+      point_obs_begin_[m + 1] += point_obs_begin_[m];
+    point_obs_.resize(point_obs_begin_.back());
+    std::vector<int> fill(point_obs_begin_.begin(), point_obs_begin_.end() - 1);
+    for (std::size_t k = 0; k < obs_.size(); ++k) {
+      const int m = point_var_[problem.observations[obs_[k]].point];
+      if (m >= 0)
+        point_obs_[static_cast<std::size_t>(fill[static_cast<std::size_t>(m)]++)] =
+            static_cast<int>(k);
+    }
+    residual_.resize(obs_.size());
+    weight_.resize(obs_.size());
+    d_camera_.resize(obs_.size());
+    d_point_.resize(obs_.size());
+    W_.resize(obs_.size());
+  }
+
+  PassReport run(std::vector<bool>& camera_moved, std::vector<bool>& point_moved) {
+    for (std::size_t i = 0; i < camera_var_.size(); ++i)
+      if (camera_var_[i] >= 0) camera_moved[i] = true;
+    for (std::size_t j = 0; j < point_var_.size(); ++j)
+      if (point_var_[j] >= 0) point_moved[j] = true;
+    PassReport report;
+    if ((obs_.empty() && priors_.empty()) || num_free_cameras_ + num_free_points_ == 0)
+      return report;
+
+    std::optional<double> cost = evaluate(state_);
+    report.converged = false;
+    if (!cost) {
+      report.summary = "a point behind its camera at the start";
+      return report;
+    }
+    const double initial_cost = *cost;
+    const char* termination = "iterations ran out";
+    int accepted = 0;
+    double radius = 1e4;  // as Ceres' Levenberg-Marquardt: mu = 1 / radius
+    double decrease_factor = 2.0;
+    linearize();
+    if (max_gradient_ <= 1e-10) {
+      report.converged = true;
+      termination = "gradient zero";
+    }
+    while (!report.converged && report.iterations < params_.max_iterations) {
+      ++report.iterations;
+      const std::optional<double> model_decrease = solveStep(1.0 / radius);
+      std::optional<double> new_cost;
+      State candidate;
+      if (model_decrease) {
+        if (step_norm_ <= 1e-8 * (parameterNorm() + 1e-8)) {
+          report.converged = true;
+          termination = "step tiny";
+          break;
+        }
+        candidate = applyStep();
+        new_cost = evaluate(candidate);
+      }
+      const double quality =
+          new_cost && *model_decrease > 0.0 ? (*cost - *new_cost) / *model_decrease : -1.0;
+      if (quality > 1e-3) {
+        ++accepted;
+        const double relative_decrease = (*cost - *new_cost) / std::max(*cost, 1e-300);
+        state_ = std::move(candidate);
+        cost = new_cost;
+        radius /= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * quality - 1.0, 3));
+        radius = std::min(radius, 1e16);
+        decrease_factor = 2.0;
+        linearize();
+        if (relative_decrease <= 1e-6 || max_gradient_ <= 1e-10) {
+          report.converged = true;
+          termination = "converged";
+        }
+      } else {
+        if (new_cost && std::abs(*cost - *new_cost) <= 1e-6 * *cost) {
+          report.converged = true;
+          termination = "converged";
+          break;
+        }
+        radius /= decrease_factor;
+        decrease_factor *= 2.0;
+        if (radius < 1e-32) {
+          termination = "no step decreases the cost";
+          break;
+        }
+      }
+    }
+    char text[160];
+    std::snprintf(text, sizeof text, "LM %d steps (%d taken), cost %.6g -> %.6g, %s",
+                  report.iterations, accepted, initial_cost, *cost, termination);
+    report.summary = text;
+    return report;
   }
 
  private:
-  BaIntrinsics K_;
-  Eigen::Vector2d px_;
-  double inv_sigma_;
-};
-
-// The rotation vector of R_ab_prior^T R_world_cam_a^T R_world_cam_b, over
-// sigma.
-class RotationPriorCost {
- public:
-  RotationPriorCost(const Eigen::Quaterniond& R_ab, double sigma_rad, double sigma_about_a_z_rad)
-      : R_ab_prior_(R_ab.normalized()),
-        R_ba_prior_(R_ab.normalized().conjugate()),
-        inv_sigma_(1.0 / sigma_rad),
-        inv_sigma_z_(1.0 / (sigma_about_a_z_rad > 0.0 ? sigma_about_a_z_rad : sigma_rad)) {}
-
-  template <typename T>
-  bool operator()(const T* q_world_cam_a, const T* q_world_cam_b, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_a(q_world_cam_a);
-    const Eigen::Map<const Eigen::Quaternion<T>> q_b(q_world_cam_b);
-    const Eigen::Quaternion<T> q_err = R_ba_prior_.cast<T>() * (q_a.conjugate() * q_b);
-    const T wxyz[4] = {q_err.w(), q_err.x(), q_err.y(), q_err.z()};
-    Eigen::Matrix<T, 3, 1> error_b;
-    ceres::QuaternionToAngleAxis(wxyz, error_b.data());
-    // In a's axes, where the heading is the part about z.
-    const Eigen::Matrix<T, 3, 1> error_a = R_ab_prior_.cast<T>() * error_b;
-    residual[0] = error_a.x() * T(inv_sigma_);
-    residual[1] = error_a.y() * T(inv_sigma_);
-    residual[2] = error_a.z() * T(inv_sigma_z_);
-    return true;
+  // The total cost, or nothing when an observation's point is not in front.
+  std::optional<double> evaluate(const State& s) const {
+    std::vector<Eigen::Matrix3d> R(s.cameras.size());
+    for (std::size_t i = 0; i < s.cameras.size(); ++i)
+      R[i] = s.cameras[i].q_world_cam.toRotationMatrix();
+    const double k = params_.huber_px;
+    std::vector<double> part(obs_.size());
+    std::vector<char> ok(obs_.size(), 1);
+    forChunks(obs_.size(), params_.num_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t n = begin; n < end; ++n) {
+        const BaObservation& obs = problem_.observations[obs_[n]];
+        Eigen::Vector2d r;
+        ok[n] = reprojectionResidual(problem_.K, obs.px, 1.0 / obs.sigma_px, R[obs.camera],
+                                     s.cameras[obs.camera].p_world_cam_m, s.points[obs.point], r,
+                                     nullptr, nullptr);
+        part[n] = ok[n] ? huberRho(r.squaredNorm(), k) : 0.0;
+      }
+    });
+    double sum = 0.0;
+    for (std::size_t n = 0; n < obs_.size(); ++n) {
+      if (!ok[n]) return std::nullopt;
+      sum += part[n];
+    }
+    for (int p : priors_) {
+      const BaRotationPrior& prior = problem_.rotation_priors[p];
+      sum += priorTerm(prior, s.cameras[prior.camera_a], s.cameras[prior.camera_b])
+                 .error.squaredNorm();
+    }
+    return 0.5 * sum;
   }
 
- private:
-  Eigen::Quaterniond R_ab_prior_;
-  Eigen::Quaterniond R_ba_prior_;
-  double inv_sigma_;
-  double inv_sigma_z_;
+  // The Gauss-Newton system at state_: H_cc (dense), the points' blocks, the
+  // camera-point blocks W, the gradient.
+  void linearize() {
+    std::vector<Eigen::Matrix3d> R(state_.cameras.size());
+    for (std::size_t i = 0; i < R.size(); ++i)
+      R[i] = state_.cameras[i].q_world_cam.toRotationMatrix();
+    const double k = params_.huber_px;
+    forChunks(obs_.size(), params_.num_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t n = begin; n < end; ++n) {
+        const BaObservation& obs = problem_.observations[obs_[n]];
+        reprojectionResidual(problem_.K, obs.px, 1.0 / obs.sigma_px, R[obs.camera],
+                             state_.cameras[obs.camera].p_world_cam_m, state_.points[obs.point],
+                             residual_[n], &d_camera_[n], &d_point_[n]);
+        weight_[n] = huberWeight(residual_[n].squaredNorm(), k);
+      }
+    });
+    const Eigen::Index nc = 6 * num_free_cameras_;
+    H_cc_.setZero(nc, nc);
+    g_c_.setZero(nc);
+    V_.assign(static_cast<std::size_t>(num_free_points_), Eigen::Matrix3d::Zero());
+    g_p_.assign(static_cast<std::size_t>(num_free_points_), Eigen::Vector3d::Zero());
+    for (std::size_t n = 0; n < obs_.size(); ++n) {
+      const BaObservation& obs = problem_.observations[obs_[n]];
+      const int c = camera_var_[obs.camera];
+      const int m = point_var_[obs.point];
+      const double w = weight_[n];
+      if (c >= 0) {
+        const Eigen::Matrix<double, 6, 2> wJt = w * d_camera_[n].transpose();
+        H_cc_.block<6, 6>(6 * c, 6 * c).noalias() += wJt * d_camera_[n];
+        g_c_.segment<6>(6 * c).noalias() += wJt * residual_[n];
+        if (m >= 0) W_[n].noalias() = wJt * d_point_[n];
+      }
+      if (m >= 0) {
+        const Eigen::Matrix<double, 3, 2> wJt = w * d_point_[n].transpose();
+        V_[static_cast<std::size_t>(m)].noalias() += wJt * d_point_[n];
+        g_p_[static_cast<std::size_t>(m)].noalias() += wJt * residual_[n];
+      }
+    }
+    for (int p : priors_) {
+      const BaRotationPrior& prior = problem_.rotation_priors[p];
+      const PriorTerm t =
+          priorTerm(prior, state_.cameras[prior.camera_a], state_.cameras[prior.camera_b]);
+      const int a = camera_var_[prior.camera_a];
+      const int b = camera_var_[prior.camera_b];
+      if (a >= 0) {
+        H_cc_.block<3, 3>(6 * a, 6 * a) += t.d_a.transpose() * t.d_a;
+        g_c_.segment<3>(6 * a) += t.d_a.transpose() * t.error;
+      }
+      if (b >= 0) {
+        H_cc_.block<3, 3>(6 * b, 6 * b) += t.d_b.transpose() * t.d_b;
+        g_c_.segment<3>(6 * b) += t.d_b.transpose() * t.error;
+      }
+      if (a >= 0 && b >= 0) {
+        H_cc_.block<3, 3>(6 * a, 6 * b) += t.d_a.transpose() * t.d_b;
+        H_cc_.block<3, 3>(6 * b, 6 * a) += t.d_b.transpose() * t.d_a;
+      }
+    }
+    max_gradient_ = g_c_.size() > 0 ? g_c_.cwiseAbs().maxCoeff() : 0.0;
+    for (const Eigen::Vector3d& g : g_p_)
+      max_gradient_ = std::max(max_gradient_, g.cwiseAbs().maxCoeff());
+  }
+
+  // Solves (H + mu D) delta = -g, D = diag(H) within [1e-6, 1e32] (Ceres'
+  // bounds), eliminating the points first. Returns the model's decrease
+  // (nothing for a step that is not finite).
+  std::optional<double> solveStep(double mu) {
+    const auto damping = [mu](double d) { return mu * std::clamp(d, 1e-6, 1e32); };
+    const Eigen::Index nc = 6 * num_free_cameras_;
+    Eigen::MatrixXd S = H_cc_;
+    Eigen::VectorXd b = g_c_;
+    Eigen::VectorXd D_c(nc);
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      D_c[i] = damping(H_cc_(i, i));
+      S(i, i) += D_c[i];
+    }
+    V_inv_.resize(static_cast<std::size_t>(num_free_points_));
+    D_p_.resize(static_cast<std::size_t>(num_free_points_));
+    // S -= W V^-1 W^T point by point, into S's lower triangle (all the LDLT reads).
+    std::vector<std::pair<int, Mat63>> seen;  // the point's free cameras and W V^-1
+    for (std::size_t m = 0; m < static_cast<std::size_t>(num_free_points_); ++m) {
+      Eigen::Matrix3d V = V_[m];
+      for (int i = 0; i < 3; ++i) {
+        D_p_[m][i] = damping(V_[m](i, i));
+        V(i, i) += D_p_[m][i];
+      }
+      V_inv_[m] = V.inverse();
+      seen.clear();
+      for (int a = point_obs_begin_[m]; a < point_obs_begin_[m + 1]; ++a) {
+        const std::size_t n = static_cast<std::size_t>(point_obs_[static_cast<std::size_t>(a)]);
+        const int c = camera_var_[problem_.observations[obs_[n]].camera];
+        if (c < 0) continue;
+        const Mat63 Y = W_[n] * V_inv_[m];
+        b.segment<6>(6 * c).noalias() -= Y * g_p_[m];
+        S.block<6, 6>(6 * c, 6 * c).noalias() -= Y * W_[n].transpose();
+        for (const auto& [c_before, Y_before] : seen) {
+          // The pair's two blocks are each other's transpose: the lower one only.
+          const Mat6 block = Y_before * W_[n].transpose();
+          if (c_before > c) {
+            S.block<6, 6>(6 * c_before, 6 * c) -= block;
+          } else if (c_before < c) {
+            S.block<6, 6>(6 * c, 6 * c_before) -= block.transpose();
+          } else {
+            S.block<6, 6>(6 * c, 6 * c) -= block + block.transpose();
+          }
+        }
+        seen.emplace_back(c, Y);
+      }
+    }
+    delta_c_ = nc > 0 ? Eigen::VectorXd(S.ldlt().solve(-b)) : Eigen::VectorXd();
+    delta_p_.resize(static_cast<std::size_t>(num_free_points_));
+    for (std::size_t m = 0; m < static_cast<std::size_t>(num_free_points_); ++m) {
+      Eigen::Vector3d rhs = -g_p_[m];
+      for (int a = point_obs_begin_[m]; a < point_obs_begin_[m + 1]; ++a) {
+        const std::size_t n = static_cast<std::size_t>(point_obs_[static_cast<std::size_t>(a)]);
+        const int c = camera_var_[problem_.observations[obs_[n]].camera];
+        if (c >= 0) rhs.noalias() -= W_[n].transpose() * delta_c_.segment<6>(6 * c);
+      }
+      delta_p_[m] = V_inv_[m] * rhs;
+    }
+    // With (H + mu D) delta = -g: delta' H delta = -g' delta - delta' mu D delta.
+    double g_dot = delta_c_.size() > 0 ? g_c_.dot(delta_c_) : 0.0;
+    double d_dot = delta_c_.size() > 0 ? delta_c_.dot(D_c.cwiseProduct(delta_c_)) : 0.0;
+    double norm_sq = delta_c_.squaredNorm();
+    for (std::size_t m = 0; m < delta_p_.size(); ++m) {
+      g_dot += g_p_[m].dot(delta_p_[m]);
+      d_dot += delta_p_[m].dot(D_p_[m].cwiseProduct(delta_p_[m]));
+      norm_sq += delta_p_[m].squaredNorm();
+    }
+    step_norm_ = std::sqrt(norm_sq);
+    if (!std::isfinite(g_dot) || !std::isfinite(d_dot)) return std::nullopt;
+    return 0.5 * (d_dot - g_dot);
+  }
+
+  State applyStep() const {
+    State s = state_;
+    for (std::size_t i = 0; i < camera_var_.size(); ++i) {
+      const int c = camera_var_[i];
+      if (c < 0) continue;
+      CameraState& cam = s.cameras[i];
+      cam.q_world_cam = (cam.q_world_cam * expMap(delta_c_.segment<3>(6 * c))).normalized();
+      cam.p_world_cam_m += delta_c_.segment<3>(6 * c + 3);
+    }
+    for (std::size_t j = 0; j < point_var_.size(); ++j)
+      if (point_var_[j] >= 0) s.points[j] += delta_p_[static_cast<std::size_t>(point_var_[j])];
+    return s;
+  }
+
+  double parameterNorm() const {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < camera_var_.size(); ++i)
+      if (camera_var_[i] >= 0)
+        sum += 1.0 + state_.cameras[i].p_world_cam_m.squaredNorm();  // a unit quaternion
+    for (std::size_t j = 0; j < point_var_.size(); ++j)
+      if (point_var_[j] >= 0) sum += state_.points[j].squaredNorm();
+    return std::sqrt(sum);
+  }
+
+  const BaProblem& problem_;
+  const BundleAdjustmentParams& params_;
+  State& state_;
+  std::vector<int> obs_;     // the active observations
+  std::vector<int> priors_;  // the priors on a free camera
+  std::vector<int> camera_var_;
+  std::vector<int> point_var_;
+  int num_free_cameras_ = 0;
+  int num_free_points_ = 0;
+  std::vector<int> point_obs_begin_;  // per free point, its entries of point_obs_
+  std::vector<int> point_obs_;        // indices into obs_
+  // Per active observation at state_.
+  std::vector<Eigen::Vector2d> residual_;
+  std::vector<double> weight_;
+  std::vector<Mat26> d_camera_;
+  std::vector<Mat23> d_point_;
+  std::vector<Mat63> W_;
+  Eigen::MatrixXd H_cc_;
+  Eigen::VectorXd g_c_;
+  std::vector<Eigen::Matrix3d> V_;
+  std::vector<Eigen::Vector3d> g_p_;
+  double max_gradient_ = 0.0;
+  // The last step.
+  std::vector<Eigen::Matrix3d> V_inv_;
+  std::vector<Eigen::Vector3d> D_p_;
+  Eigen::VectorXd delta_c_;
+  std::vector<Eigen::Vector3d> delta_p_;
+  double step_norm_ = 0.0;
 };
 
 // The reprojection error in px, or nothing when the point is not in front.
-bool reprojectionError(const BaIntrinsics& K, const CameraBlocks& cam,
-                       const std::array<double, 3>& p_world_m, const Eigen::Vector2d& px,
+bool reprojectionError(const BaIntrinsics& K, const CameraState& cam,
+                       const Eigen::Vector3d& p_world_m, const Eigen::Vector2d& px,
                        Eigen::Vector2d& error_px) {
-  const Eigen::Map<const Eigen::Quaterniond> q(cam.q_world_cam.data());
-  const Eigen::Map<const Eigen::Vector3d> centre(cam.p_world_cam_m.data());
-  const Eigen::Map<const Eigen::Vector3d> point(p_world_m.data());
-  const Eigen::Vector3d p_cam = q.conjugate() * (point - centre);
-  if (!(p_cam.z() > 0.0)) {
-    return false;
-  }
-  error_px =
-      Eigen::Vector2d(K.fx * p_cam.x() / p_cam.z() + K.cx, K.fy * p_cam.y() / p_cam.z() + K.cy) -
-      px;
-  return true;
+  return reprojectionResidual(K, px, 1.0, cam.q_world_cam.toRotationMatrix(), cam.p_world_cam_m,
+                              p_world_m, error_px, nullptr, nullptr);
 }
 
 void checkCamera(int index, const BaProblem& problem, const char* what) {
@@ -126,7 +507,6 @@ void checkCamera(int index, const BaProblem& problem, const char* what) {
                                 " cameras");
   }
 }
-
 void validate(const BaProblem& problem) {
   if (!(problem.K.fx > 0.0) || !(problem.K.fy > 0.0)) {
     throw std::invalid_argument("bundleAdjust: the focal lengths must be positive");
@@ -162,146 +542,6 @@ double rmse(double sum_squares, int count) {
   return count > 0 ? std::sqrt(sum_squares / (2.0 * count)) : 0.0;
 }
 
-// The parameter blocks of one call: copies of the cameras and points that
-// Ceres refines, written back at the end.
-struct State {
-  std::vector<CameraBlocks> cameras;
-  std::vector<std::array<double, 3>> points;
-};
-
-struct PassReport {
-  bool converged = true;
-  int iterations = 0;
-  std::string summary = "nothing to adjust";
-};
-
-// One Levenberg-Marquardt solve over the active observations and the priors,
-// in place on state; marks the free cameras and points that took part.
-PassReport solvePass(const BaProblem& problem, const BundleAdjustmentParams& params,
-                     const std::vector<bool>& active, State& state, std::vector<bool>& camera_moved,
-                     std::vector<bool>& point_moved) {
-  const std::size_t num_cameras = problem.cameras.size();
-  std::vector<bool> rotation_used(num_cameras, false);
-  std::vector<bool> position_used(num_cameras, false);
-  std::vector<bool> point_used(problem.points.size(), false);
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    if (active[i]) {
-      const BaObservation& obs = problem.observations[i];
-      rotation_used[obs.camera] = position_used[obs.camera] = true;
-      point_used[obs.point] = true;
-    }
-  }
-  std::vector<bool> prior_used(problem.rotation_priors.size(), false);
-  for (std::size_t i = 0; i < problem.rotation_priors.size(); ++i) {
-    const BaRotationPrior& prior = problem.rotation_priors[i];
-    if (!problem.cameras[prior.camera_a].fixed || !problem.cameras[prior.camera_b].fixed) {
-      prior_used[i] = rotation_used[prior.camera_a] = rotation_used[prior.camera_b] = true;
-    }
-  }
-
-  // The problem owns the costs; the one loss and manifold shared by all blocks
-  // live here (declared first, they outlive the problem).
-  ceres::EigenQuaternionManifold quaternion_manifold;
-  std::unique_ptr<ceres::LossFunction> huber;
-  if (params.huber_px > 0.0) {
-    huber = std::make_unique<ceres::HuberLoss>(params.huber_px);
-  }
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem ceres_problem(problem_options);
-
-  // Parameter blocks; the free points go first in the elimination order.
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  int free_points = 0;
-  int free_cameras = 0;
-  for (std::size_t j = 0; j < point_used.size(); ++j) {
-    if (!point_used[j]) {
-      continue;
-    }
-    double* block = state.points[j].data();
-    ceres_problem.AddParameterBlock(block, 3);
-    if (problem.points[j].fixed) {
-      ceres_problem.SetParameterBlockConstant(block);
-    } else {
-      ordering->AddElementToGroup(block, 0);
-      point_moved[j] = true;
-      ++free_points;
-    }
-  }
-  for (std::size_t i = 0; i < num_cameras; ++i) {
-    const bool fixed = problem.cameras[i].fixed;
-    double* q = state.cameras[i].q_world_cam.data();
-    double* p = state.cameras[i].p_world_cam_m.data();
-    if (rotation_used[i]) {
-      ceres_problem.AddParameterBlock(q, 4, &quaternion_manifold);
-    }
-    if (position_used[i]) {
-      ceres_problem.AddParameterBlock(p, 3);
-    }
-    if (!rotation_used[i] && !position_used[i]) {
-      continue;
-    }
-    if (fixed) {
-      if (rotation_used[i]) ceres_problem.SetParameterBlockConstant(q);
-      if (position_used[i]) ceres_problem.SetParameterBlockConstant(p);
-      continue;
-    }
-    if (rotation_used[i]) ordering->AddElementToGroup(q, 1);
-    if (position_used[i]) ordering->AddElementToGroup(p, 1);
-    camera_moved[i] = true;
-    ++free_cameras;
-  }
-
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    if (!active[i]) {
-      continue;
-    }
-    const BaObservation& obs = problem.observations[i];
-    auto* cost = new ceres::AutoDiffCostFunction<ReprojectionCost, 2, 4, 3, 3>(
-        new ReprojectionCost(problem.K, obs.px, obs.sigma_px));
-    ceres_problem.AddResidualBlock(cost, huber.get(), state.cameras[obs.camera].q_world_cam.data(),
-                                   state.cameras[obs.camera].p_world_cam_m.data(),
-                                   state.points[obs.point].data());
-  }
-  for (std::size_t i = 0; i < problem.rotation_priors.size(); ++i) {
-    if (!prior_used[i]) {
-      continue;
-    }
-    const BaRotationPrior& prior = problem.rotation_priors[i];
-    auto* cost = new ceres::AutoDiffCostFunction<RotationPriorCost, 3, 4, 4>(
-        new RotationPriorCost(prior.R_ab, prior.sigma_rad, prior.sigma_about_a_z_rad));
-    ceres_problem.AddResidualBlock(cost, nullptr, state.cameras[prior.camera_a].q_world_cam.data(),
-                                   state.cameras[prior.camera_b].q_world_cam.data());
-  }
-
-  PassReport report;
-  if (ceres_problem.NumResidualBlocks() == 0 || free_points + free_cameras == 0) {
-    return report;
-  }
-  ceres::Solver::Options options;
-  options.minimizer_type = ceres::TRUST_REGION;
-  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.max_num_iterations = params.max_iterations;
-  options.num_threads = params.num_threads;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
-  if (free_points > 0 && free_cameras > 0) {
-    // A key-frame window's reduced camera system is small and dense.
-    options.linear_solver_type = free_cameras <= 40 ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
-    options.linear_solver_ordering = ordering;
-  } else {
-    options.linear_solver_type =
-        free_points + free_cameras <= 40 ? ceres::DENSE_QR : ceres::SPARSE_NORMAL_CHOLESKY;
-  }
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &ceres_problem, &summary);
-  report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
-  report.summary = summary.BriefReport();
-  return report;
-}
-
 }  // namespace
 
 BaResult bundleAdjust(BaProblem& problem, const BundleAdjustmentParams& params) {
@@ -312,15 +552,13 @@ BaResult bundleAdjust(BaProblem& problem, const BundleAdjustmentParams& params) 
   state.cameras.resize(problem.cameras.size());
   for (std::size_t i = 0; i < problem.cameras.size(); ++i) {
     const Eigen::Isometry3d& T = problem.cameras[i].T_world_cam;
-    const Eigen::Quaterniond q(T.rotation());
-    state.cameras[i].q_world_cam = {q.x(), q.y(), q.z(), q.w()};
-    state.cameras[i].p_world_cam_m = {T.translation().x(), T.translation().y(),
-                                      T.translation().z()};
+    state.cameras[i].q_world_cam = Eigen::Quaterniond(T.rotation()).normalized();
+    state.cameras[i].p_world_cam_m = T.translation();
   }
   state.points.resize(problem.points.size());
   for (std::size_t j = 0; j < problem.points.size(); ++j) {
     const Eigen::Vector3d& p = problem.points[j].p_world_m;
-    state.points[j] = {p.x(), p.y(), p.z()};
+    state.points[j] = p;
   }
 
   // Observations of points in front of their camera at the start take part.
@@ -354,7 +592,7 @@ BaResult bundleAdjust(BaProblem& problem, const BundleAdjustmentParams& params) 
 
   std::vector<bool> camera_moved(problem.cameras.size(), false);
   std::vector<bool> point_moved(problem.points.size(), false);
-  PassReport pass = solvePass(problem, params, in_front, state, camera_moved, point_moved);
+  PassReport pass = LmPass(problem, params, in_front, state).run(camera_moved, point_moved);
   BaResult result;
   result.converged = pass.converged;
   result.iterations = pass.iterations;
@@ -367,7 +605,7 @@ BaResult bundleAdjust(BaProblem& problem, const BundleAdjustmentParams& params) 
     for (std::size_t i = 0; i < num_obs; ++i) {
       active[i] = !outlier[i];
     }
-    pass = solvePass(problem, params, active, state, camera_moved, point_moved);
+    pass = LmPass(problem, params, active, state).run(camera_moved, point_moved);
     result.converged = pass.converged;
     result.iterations += pass.iterations;
     result.summary += "; without " + std::to_string(num_outliers) + " outliers: " + pass.summary;
@@ -383,15 +621,14 @@ BaResult bundleAdjust(BaProblem& problem, const BundleAdjustmentParams& params) 
     if (!camera_moved[i]) {
       continue;
     }
-    const std::array<double, 4>& q = state.cameras[i].q_world_cam;
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-    T.translation() = Eigen::Map<const Eigen::Vector3d>(state.cameras[i].p_world_cam_m.data());
+    T.linear() = state.cameras[i].q_world_cam.normalized().toRotationMatrix();
+    T.translation() = state.cameras[i].p_world_cam_m;
     problem.cameras[i].T_world_cam = T;
   }
   for (std::size_t j = 0; j < problem.points.size(); ++j) {
     if (point_moved[j]) {
-      problem.points[j].p_world_m = Eigen::Map<const Eigen::Vector3d>(state.points[j].data());
+      problem.points[j].p_world_m = state.points[j];
     }
   }
 

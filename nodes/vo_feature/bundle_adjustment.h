@@ -1,20 +1,20 @@
 #pragma once
 // Local bundle adjustment for the feature-based VO: refines camera poses and
 // 3-D points by minimising the reprojection error of their observations in
-// undistorted pinhole images (Ceres, Levenberg-Marquardt, Schur complement),
-// optionally with priors on the relative rotation of camera pairs (the IMU's
-// rotation between frames).
+// undistorted pinhole images, optionally with priors on the relative rotation
+// of camera pairs (the IMU's rotation between frames).
 //
 // The cost: for every observation the reprojection error e = pi(K,
 // T_world_cam^-1 p_world_m) - px, whitened by sigma_px and passed through a
 // Huber loss of threshold huber_px (on e / sigma_px, so in px at sigma_px = 1);
 // for every rotation prior the rotation vector of R_ab_prior^T R_ab /
-// sigma_rad. Cameras are parametrised by T_world_cam (a unit quaternion on
-// Ceres' EigenQuaternionManifold and the camera centre in the world frame).
+// sigma_rad. The solver is Levenberg-Marquardt with Ceres Solver's trust-region
+// rules, the points eliminated by the Schur complement and the cameras'
+// reduced system solved dense; a camera moves by a rotation on its side and a
+// shift of its centre (docs/vo_feature.md, "Local bundle adjustment").
 //
 // The gauge is the caller's: fixed cameras and points are held constant
-// (fix two cameras, or one camera and a point, for monocular scale). Ceres
-// stays out of this header.
+// (fix two cameras, or one camera and a point, for monocular scale).
 
 #include <string>
 #include <vector>
@@ -23,6 +23,7 @@
 #include <Eigen/Geometry>
 
 #include "core/params.h"
+#include "nodes/vo_feature/reprojection.h"
 
 namespace nadir::vo {
 
@@ -40,7 +41,8 @@ struct BundleAdjustmentParams {
   // the Huber loss bounds an outlier's pull but does not remove it), and again
   // while the flags change, at most this many times; 0: one solve.
   int outlier_rounds = 2;
-  // Solver threads; 1 keeps the result bit-identical between runs.
+  // Threads evaluating the residuals and their Jacobians; the result does not
+  // depend on them.
   int num_threads = 1;
 
   void visit(core::ParamVisitor& v);
@@ -63,14 +65,6 @@ struct BaObservation {
   Eigen::Vector2d px = Eigen::Vector2d::Zero();
   // Standard deviation of each pixel coordinate, px (e.g. 1.2^octave).
   double sigma_px = 1.0;
-};
-
-// Undistorted pinhole intrinsics, px.
-struct BaIntrinsics {
-  double fx = 1.0;
-  double fy = 1.0;
-  double cx = 0.0;
-  double cy = 0.0;
 };
 
 // A prior on the rotation between two cameras: R_ab = R_world_cam_a^T
@@ -97,7 +91,7 @@ struct BaProblem {
 struct BaResult {
   // The last solve converged (false also when max_iterations ran out).
   bool converged = false;
-  // Levenberg-Marquardt iterations per solve.of all solves (successful and unsuccessful steps).
+  // Levenberg-Marquardt iterations of all solves (successful and unsuccessful steps).
   int iterations = 0;
   // Root mean square of the reprojection error per image coordinate, px,
   // before and after solving, over the observations not flagged as outliers
@@ -108,7 +102,8 @@ struct BaResult {
   // because the point was behind the camera.
   std::vector<bool> outlier;
   int num_outliers = 0;
-  // Ceres' brief report of each solve and the outlier count.
+  // A line per solve (steps, cost before and after, how it ended) and the
+  // outlier count.
   std::string summary;
 };
 

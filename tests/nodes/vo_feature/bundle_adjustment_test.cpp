@@ -247,7 +247,8 @@ TEST(BundleAdjustmentTest, FlagsGrossOutliersWithoutSpoilingTheResult) {
   expectCamerasNear(scene.problem, without_outliers, 0.04, 0.02 * kDeg);
 }
 
-// Two runs on the same input give bit-identical cameras, points and errors.
+// Two runs, and runs on one thread and on four (the residuals evaluated in
+// chunks, the sums taken in one order), give the same bits.
 TEST(BundleAdjustmentTest, TwoRunsAreBitIdentical) {
   SceneSpec spec;
   spec.outlier_fraction = 0.05;
@@ -255,16 +256,22 @@ TEST(BundleAdjustmentTest, TwoRunsAreBitIdentical) {
   const Scene scene = makeScene(spec);
   BaProblem a = scene.problem;
   BaProblem b = scene.problem;
+  BaProblem threaded = scene.problem;
+  BundleAdjustmentParams four_threads;
+  four_threads.num_threads = 4;
   const BaResult ra = bundleAdjust(a, {});
   const BaResult rb = bundleAdjust(b, {});
-  EXPECT_EQ(ra.final_rmse_px, rb.final_rmse_px);
-  EXPECT_EQ(ra.iterations, rb.iterations);
-  EXPECT_EQ(ra.outlier, rb.outlier);
-  for (std::size_t i = 0; i < a.cameras.size(); ++i) {
-    EXPECT_TRUE(a.cameras[i].T_world_cam.matrix() == b.cameras[i].T_world_cam.matrix());
-  }
-  for (std::size_t j = 0; j < a.points.size(); ++j) {
-    EXPECT_TRUE(a.points[j].p_world_m == b.points[j].p_world_m);
+  const BaResult rt = bundleAdjust(threaded, four_threads);
+  for (const auto& [other, r] : {std::pair{&b, &rb}, std::pair{&threaded, &rt}}) {
+    EXPECT_EQ(ra.final_rmse_px, r->final_rmse_px);
+    EXPECT_EQ(ra.iterations, r->iterations);
+    EXPECT_EQ(ra.outlier, r->outlier);
+    for (std::size_t i = 0; i < a.cameras.size(); ++i) {
+      EXPECT_TRUE(a.cameras[i].T_world_cam.matrix() == other->cameras[i].T_world_cam.matrix());
+    }
+    for (std::size_t j = 0; j < a.points.size(); ++j) {
+      EXPECT_TRUE(a.points[j].p_world_m == other->points[j].p_world_m);
+    }
   }
 }
 
