@@ -133,6 +133,11 @@ void FeatureVoParams::visit(core::ParamVisitor& v) {
            .max = 1.0});
   v.field("scale_gain", &scale_gain,
           {.doc = "share of the scale error corrected per key-frame", .min = 0.0, .max = 1.0});
+  v.field("scale_max_step", &scale_max_step,
+          {.doc = "largest change of the map's scale at one key-frame (a wild map range moves it "
+                  "no more)",
+           .min = 0.0,
+           .max = 1.0});
   v.field("range_window_px", &range_window_px,
           {.doc = "the map's range is taken from points within this of the rangefinder ray's "
                   "image, px",
@@ -651,12 +656,13 @@ void FeatureVo::addKeyframe(const Frame& cur, const VoFrameInput& in) {
   const std::optional<double> map_range = mapRange(newest, in);
   if (!map_range || !(*map_range > 0.0)) return;
   last_scale_ratio_ = *map_range / *in.range_m;
-  if (std::abs(last_scale_ratio_ - 1.0) <= params_.scale_tolerance) return;
+  const double factor = scaleCorrection(last_scale_ratio_, params_.scale_tolerance,
+                                        params_.scale_gain, params_.scale_max_step);
+  if (factor == 1.0) return;
   // Scale the whole map about the new key-frame's centre, a similarity that
   // keeps every attitude: its pose stays, the motion measured from here on
   // comes out closer to metric.
-  scaleMap(newest.T_world_cam.translation(),
-           1.0 + params_.scale_gain * (1.0 / last_scale_ratio_ - 1.0));
+  scaleMap(newest.T_world_cam.translation(), factor);
 }
 
 void FeatureVo::scaleMap(const Eigen::Vector3d& c, double factor) {

@@ -93,9 +93,11 @@ struct FeatureVoParams {
   // The lens's vignetting and the response, as calibrated: frames are
   // divided by the vignetting before features are found (photometric.h).
   PhotometricCalibration photometric;
-  // Scale upkeep: correct when |range ratio - 1| exceeds this, by this share.
+  // Scale upkeep: correct when |range ratio - 1| exceeds this, by this share,
+  // by at most scale_max_step at one key-frame.
   double scale_tolerance = 0.002;
   double scale_gain = 0.5;
+  double scale_max_step = 0.02;
   // The map's range is taken from the points seen within this many pixels of
   // the rangefinder ray's image.
   double range_window_px = 120.0;

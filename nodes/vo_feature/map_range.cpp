@@ -61,4 +61,9 @@ std::optional<double> rangeToPlaneAlongRay(const std::vector<Eigen::Vector3d>& p
   return range;
 }
 
+double scaleCorrection(double ratio, double tolerance, double gain, double max_step) {
+  if (!(ratio > 0.0) || std::abs(ratio - 1.0) <= tolerance) return 1.0;
+  return std::clamp(1.0 + gain * (1.0 / ratio - 1.0), 1.0 - max_step, 1.0 + max_step);
+}
+
 }  // namespace nadir::vo

@@ -87,5 +87,18 @@ TEST(MapRange, TooFewPointsAPlaneSeenEdgeOnOrBehindGiveNoRange) {
   EXPECT_FALSE(rangeToPlaneAlongRay(behind, Eigen::Vector3d::UnitZ()));
 }
 
+// The scale upkeep's factor, worked out by hand: within the tolerance none; a
+// ratio of 1.01 at gain 0.5 is 1 - 0.5 * 0.01 / 1.01; the wild ratios of a bad
+// plane (0.29 would scale the map by 2.22, 2.21 by 0.726) stop at 2 %.
+TEST(ScaleCorrection, HalfTheErrorWithinTheLargestStep) {
+  EXPECT_EQ(scaleCorrection(1.0015, 0.002, 0.5, 0.02), 1.0);
+  EXPECT_EQ(scaleCorrection(0.9985, 0.002, 0.5, 0.02), 1.0);
+  EXPECT_NEAR(scaleCorrection(1.01, 0.002, 0.5, 0.02), 1.0 - 0.005 / 1.01, 1e-15);
+  EXPECT_NEAR(scaleCorrection(0.99, 0.002, 0.5, 0.02), 1.0 + 0.005 / 0.99, 1e-15);
+  EXPECT_EQ(scaleCorrection(0.29, 0.002, 0.5, 0.02), 1.02);
+  EXPECT_EQ(scaleCorrection(2.21, 0.002, 0.5, 0.02), 0.98);
+  EXPECT_EQ(scaleCorrection(0.0, 0.002, 0.5, 0.02), 1.0);  // no range: nothing to correct
+}
+
 }  // namespace
 }  // namespace nadir::vo
