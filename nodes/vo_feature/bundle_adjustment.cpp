@@ -38,7 +38,6 @@ void BundleAdjustmentParams::visit(core::ParamVisitor& v) {
 
 namespace {
 
-using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat26 = Eigen::Matrix<double, 2, 6>;
 using Mat23 = Eigen::Matrix<double, 2, 3>;
