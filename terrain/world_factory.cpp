@@ -12,8 +12,12 @@
 namespace nadir::terrain {
 
 void WorldParams::visit(core::ParamVisitor& v) {
-  v.field("kind", &kind, {.doc = "procedural or files", .choices = {"procedural", "files"}});
+  v.field("kind", &kind,
+          {.doc = "procedural, files or checkerboard",
+           .choices = {"procedural", "files", "checkerboard"}});
   core::visitGroup(v, "procedural", "the procedural world (kind: procedural)", procedural);
+  core::visitGroup(v, "checkerboard", "a calibration board on flat ground (kind: checkerboard)",
+                   checkerboard);
   v.field("dem_path", &dem_path, {.doc = "files: elevation (.hgt, GeoTIFF, .asc)"});
   v.field("imagery_path", &imagery_path,
           {.doc = "files: RGB GeoTIFF, or a plain image placed by imagery_bounds_deg"});
@@ -47,6 +51,14 @@ BuiltWorld makeWorld(const WorldParams& params) {
     built.description = "procedural world, seed " + std::to_string(params.procedural.seed) + ", " +
                         std::to_string(static_cast<int>(params.procedural.size_m)) + " m square";
     built.world = world;
+    return built;
+  }
+  if (params.kind == "checkerboard") {
+    const CheckerboardParams& board = params.checkerboard;
+    built.world = std::make_shared<CheckerboardWorld>(board);
+    built.description = "checkerboard, " + std::to_string(board.inner_cols) + "x" +
+                        std::to_string(board.inner_rows) + " inner corners, " +
+                        std::to_string(board.square_m) + " m squares";
     return built;
   }
   if (params.dem_path.empty()) throw core::ParamError("world.dem_path: a files world needs a DEM");

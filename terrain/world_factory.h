@@ -8,15 +8,17 @@
 
 #include "core/geodesy.h"
 #include "core/params.h"
+#include "terrain/checkerboard_world.h"
 #include "terrain/procedural_world.h"
 #include "terrain/world.h"
 
 namespace nadir::terrain {
 
 struct WorldParams {
-  // "procedural" or "files".
+  // "procedural", "files" or "checkerboard" (a calibration board on flat ground).
   std::string kind = "procedural";
   ProceduralWorldParams procedural;
+  CheckerboardParams checkerboard;
   // files: a DEM (.hgt, GeoTIFF, ESRI .asc).
   std::string dem_path;
   // files: imagery as one RGB GeoTIFF, or a plain image with imagery_bounds_deg;

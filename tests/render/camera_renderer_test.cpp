@@ -13,16 +13,18 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "checker_world.h"
 #include "core/frames.h"
 #include "nodes/common/photometric.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
+#include "terrain/checkerboard_world.h"
 
 namespace nadir::render {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
+// 9 x 7 squares of 1 m: 8 inner corners along north, 6 along east.
+const terrain::CheckerboardParams kBoard{.inner_cols = 6, .inner_rows = 8, .square_m = 1.0};
 
 // Camera pose of a body at (north, east, down) with roll/pitch/yaw carrying a down camera.
 Eigen::Isometry3d downCameraPose(const Eigen::Vector3d& p_ned, double roll, double pitch,
@@ -36,12 +38,12 @@ Eigen::Isometry3d downCameraPose(const Eigen::Vector3d& p_ned, double roll, doub
 
 struct Fixture {
   HeadlessGlContext context;
-  std::shared_ptr<test::CheckerWorld> world;
+  std::shared_ptr<terrain::CheckerboardWorld> world;
   std::shared_ptr<terrain::TileTree> tiles;
   std::unique_ptr<TerrainRenderer> terrain;
 
   explicit Fixture(double ground_up_m = 0.0) {
-    world = std::make_shared<test::CheckerWorld>(9, 7, 1.0, ground_up_m);
+    world = std::make_shared<terrain::CheckerboardWorld>(kBoard, ground_up_m);
     terrain::TileParams tile_params;
     tile_params.texture_px = 256;
     tiles = std::make_shared<terrain::TileTree>(world, tile_params);
@@ -70,7 +72,8 @@ double worstCornerError(const std::vector<cv::Point2f>& detected,
   return worst;
 }
 
-std::vector<Eigen::Vector3d> boardCorners(const test::CheckerWorld& world, double ground_up_m) {
+std::vector<Eigen::Vector3d> boardCorners(const terrain::CheckerboardWorld& world,
+                                          double ground_up_m) {
   std::vector<Eigen::Vector3d> corners;
   for (int i = 0; i < 8; ++i) {
     for (int j = 0; j < 6; ++j)
@@ -181,9 +184,9 @@ TEST(CameraRenderer, DepthIsDistanceAlongOpticalAxis) {
 
 // The checkerboard world with one flat-roofed building, 4 m x 4 m and 6 m
 // tall, centred 5 m north of the origin.
-class BuildingWorld : public test::CheckerWorld {
+class BuildingWorld : public terrain::CheckerboardWorld {
  public:
-  BuildingWorld() : CheckerWorld(9, 7, 1.0) {}
+  BuildingWorld() : CheckerboardWorld(kBoard) {}
   std::vector<terrain::GroundObject> objects(const terrain::GroundSquare& sq) const override {
     terrain::GroundObject building;
     building.kind = terrain::GroundObject::Kind::kBuilding;
@@ -280,7 +283,7 @@ TEST(CameraRenderer, ConcentricTargetIsDrawnWithItsRings) {
 // The GPU tile cache stays within its budget while flying over many tiles.
 TEST(CameraRenderer, TileCacheRespectsItsBudget) {
   HeadlessGlContext context;
-  auto world = std::make_shared<test::CheckerWorld>(9, 7, 1.0);
+  auto world = std::make_shared<terrain::CheckerboardWorld>(kBoard);
   terrain::TileParams tile_params;
   tile_params.texture_px = 64;
   auto tiles = std::make_shared<terrain::TileTree>(world, tile_params);

@@ -4,7 +4,9 @@
 #include <numbers>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
+#include "terrain/checkerboard_world.h"
 #include "terrain/georef.h"
 #include "terrain/world_factory.h"
 #include "terrain_test_util.h"
@@ -55,6 +57,35 @@ TEST(WorldFactory, FilesWorldNeedsAReadableDem) {
   } catch (const TerrainError& error) {
     EXPECT_NE(std::string(error.what()).find("no_such_dem.tif"), std::string::npos);
   }
+}
+
+// A checkerboard world: 9 x 6 inner corners of 0.025 m squares make a board
+// of 10 x 7 squares, 0.25 m east by 0.175 m north, centred on the origin; the
+// south-west square is dark, its east neighbour light, a square of white
+// margin around, mid-grey ground beyond; flat at 0.
+TEST(WorldFactory, CheckerboardWorld) {
+  WorldParams params;
+  params.kind = "checkerboard";
+  params.checkerboard = {.inner_cols = 9, .inner_rows = 6, .square_m = 0.025};
+  const BuiltWorld built = makeWorld(params);
+  EXPECT_NE(built.description.find("9x6"), std::string::npos);
+  EXPECT_EQ(built.world->groundUp_m(0.3, -2.0), 0.0);
+  const auto& board = dynamic_cast<const CheckerboardWorld&>(*built.world);
+  EXPECT_NEAR(board.cornerNorth_m(0), -0.0875 + 0.025, 1e-12);
+  EXPECT_NEAR(board.cornerEast_m(8), 0.125 - 0.025, 1e-12);
+  // One pixel per 1 mm square of ground, sampled at the centres of squares.
+  const auto grey = [&](double north_m, double east_m) {
+    cv::Mat rgb;
+    built.world->imagery({north_m - 0.0005, east_m - 0.0005, 0.001}, 1, rgb);
+    return static_cast<int>(rgb.at<cv::Vec3b>(0, 0)[0]);
+  };
+  EXPECT_EQ(grey(-0.075, -0.1125), 20);   // south-west square
+  EXPECT_EQ(grey(-0.075, -0.0875), 235);  // its east neighbour
+  EXPECT_EQ(grey(-0.050, -0.0875), 20);   // and the one north of that
+  EXPECT_EQ(grey(-0.100, 0.0), 235);      // the margin south of the board
+  EXPECT_EQ(grey(0.0, 0.2), 128);         // the ground beyond
+  params.checkerboard.square_m = 0.0;
+  EXPECT_THROW(makeWorld(params), core::ParamError);
 }
 
 }  // namespace

@@ -5,12 +5,17 @@
 #include <algorithm>
 #include <cmath>
 
-#include "checker_world.h"
+#include <opencv2/core.hpp>
+
 #include "nodes/camera/camera_rig.h"
 #include "render/egl_context.h"
+#include "terrain/checkerboard_world.h"
 
 namespace nadir::camera {
 namespace {
+
+// 9 x 7 squares of 1 m: 8 inner corners along north, 6 along east.
+const terrain::CheckerboardParams kBoard{.inner_cols = 6, .inner_rows = 8, .square_m = 1.0};
 
 struct Rig {
   render::HeadlessGlContext context;
@@ -19,7 +24,7 @@ struct Rig {
   std::unique_ptr<CameraRig> rig;
 
   explicit Rig(const std::map<std::string, CameraSpec>& specs) {
-    auto world = std::make_shared<test::CheckerWorld>(9, 7, 1.0);
+    auto world = std::make_shared<terrain::CheckerboardWorld>(kBoard);
     terrain::TileParams tile_params;
     tile_params.texture_px = 64;
     tiles = std::make_shared<terrain::TileTree>(world, tile_params);
