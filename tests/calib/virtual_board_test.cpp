@@ -16,7 +16,7 @@
 namespace nadir::calib {
 namespace {
 
-// The issue's virtual camera: 1280 x 960, 84.9 deg, k1 = -0.20, k2 = 0.05.
+// The calibration target's virtual camera: 1280 x 960, 84.9 deg, k1 = -0.20, k2 = 0.05.
 render::CameraParams issueCamera() {
   render::CameraParams camera;
   camera.width = 1280;
