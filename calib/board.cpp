@@ -37,6 +37,52 @@ double shortestNeighbourSpacing_px(const std::vector<cv::Point2f>& corners,
   return shortest;
 }
 
+// Whether the checker pattern goes on past the detected grid: then the grid is
+// part of a larger board (findChessboardCornersSB finds a 7x5 grid inside a
+// 9x6 board). The squares just outside the outer corners alternate on any
+// board; one square farther out lies the board's margin for the whole board,
+// more alternating squares for a part of it. Sampled through the homography
+// of the corners (local enough to ignore the lens). On OpenCV's sample
+// photographs the step one square out is 0.21-0.56 of the outer squares' for
+// the whole 9x6 board (a cluttered background behind a narrow margin), 0.95
+// and 2.9 for the two 7x5 parts found in them: the line is drawn at 0.8.
+bool gridContinues(const cv::Mat& gray, const std::vector<cv::Point2f>& corners,
+                   const BoardSpec& board) {
+  const int cols = board.inner_cols, rows = board.inner_rows;
+  std::vector<cv::Point2f> grid;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) grid.emplace_back(static_cast<float>(c), static_cast<float>(r));
+  const cv::Mat H = cv::findHomography(grid, corners);
+  if (H.empty()) return false;
+  // Mean absolute step between neighbouring square centres along a ring at
+  // offset d squares outside the corners (d = 0.5: the board's outer squares).
+  const auto ringContrast = [&](double d) {
+    std::vector<cv::Point2f> ring;
+    for (int c = -1; c < cols; ++c) ring.emplace_back(c + 0.5f, static_cast<float>(-d));
+    for (int r = -1; r < rows; ++r) ring.emplace_back(static_cast<float>(cols - 1 + d), r + 0.5f);
+    for (int c = cols - 1; c >= 0; --c)
+      ring.emplace_back(c - 0.5f, static_cast<float>(rows - 1 + d));
+    for (int r = rows - 1; r >= 0; --r) ring.emplace_back(static_cast<float>(-d), r - 0.5f);
+    std::vector<cv::Point2f> pixels;
+    cv::perspectiveTransform(ring, pixels, H);
+    double sum = 0.0;
+    int steps = 0;
+    for (std::size_t i = 0; i + 1 < pixels.size(); ++i) {
+      const cv::Point2f& a = pixels[i];
+      const cv::Point2f& b = pixels[i + 1];
+      const cv::Rect inside(0, 0, gray.cols, gray.rows);
+      if (!inside.contains(cv::Point(a)) || !inside.contains(cv::Point(b))) continue;
+      sum += std::abs(double(gray.at<std::uint8_t>(cv::Point(a))) -
+                      double(gray.at<std::uint8_t>(cv::Point(b))));
+      ++steps;
+    }
+    return steps >= 4 ? sum / steps : 0.0;
+  };
+  const double outer_squares = ringContrast(0.5);
+  const double beyond = ringContrast(1.5);
+  return outer_squares > 0.0 && beyond > 0.8 * outer_squares;
+}
+
 }  // namespace
 
 BoardSpec parseBoardSpec(std::string_view cols_x_rows, double square_m) {
@@ -152,21 +198,10 @@ void refineCorners(const cv::Mat& gray, std::vector<cv::Point2f>& corners_px,
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
 }
 
-std::optional<Detection> detectBoard(const cv::Mat& gray_or_bgr, const BoardSpec& board) {
-  validateBoard(board);
-  if (gray_or_bgr.empty()) throw std::invalid_argument("detectBoard: the image is empty");
-  if (gray_or_bgr.depth() != CV_8U ||
-      (gray_or_bgr.channels() != 1 && gray_or_bgr.channels() != 3 && gray_or_bgr.channels() != 4))
-    throw std::invalid_argument(
-        "detectBoard: the image must be 8-bit grey, BGR or BGRA, not type " +
-        std::to_string(gray_or_bgr.type()));
-  cv::Mat gray;
-  if (gray_or_bgr.channels() == 1)
-    gray = gray_or_bgr;
-  else
-    cv::cvtColor(gray_or_bgr, gray,
-                 gray_or_bgr.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+namespace {
 
+// The detectors in turn on one image; corners in its pixels.
+std::optional<Detection> findBoard(const cv::Mat& gray, const BoardSpec& board) {
   Detection detection;
   const cv::Size pattern = board.patternSize();
   if (cv::findChessboardCornersSB(gray, pattern, detection.corners_px,
@@ -183,7 +218,53 @@ std::optional<Detection> detectBoard(const cv::Mat& gray_or_bgr, const BoardSpec
     return std::nullopt;
   }
   if (static_cast<int>(detection.corners_px.size()) != board.cornerCount()) return std::nullopt;
+  return detection;
+}
+
+}  // namespace
+
+std::optional<Detection> detectBoard(const cv::Mat& gray_or_bgr, const BoardSpec& board,
+                                     const DetectOptions& options) {
+  validateBoard(board);
+  if (gray_or_bgr.empty()) throw std::invalid_argument("detectBoard: the image is empty");
+  if (gray_or_bgr.depth() != CV_8U ||
+      (gray_or_bgr.channels() != 1 && gray_or_bgr.channels() != 3 && gray_or_bgr.channels() != 4))
+    throw std::invalid_argument(
+        "detectBoard: the image must be 8-bit grey, BGR or BGRA, not type " +
+        std::to_string(gray_or_bgr.type()));
+  cv::Mat gray;
+  if (gray_or_bgr.channels() == 1)
+    gray = gray_or_bgr;
+  else
+    cv::cvtColor(gray_or_bgr, gray,
+                 gray_or_bgr.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+
+  const cv::Size pattern = board.patternSize();
+  const int longer_side = std::max(gray.cols, gray.rows);
+  std::optional<Detection> found;
+  if (options.search_side_px > 0 && longer_side > options.search_side_px) {
+    const double scale = static_cast<double>(longer_side) / options.search_side_px;
+    cv::Mat small;
+    cv::resize(gray, small,
+               cv::Size(static_cast<int>(std::lround(gray.cols / scale)),
+                        static_cast<int>(std::lround(gray.rows / scale))),
+               0, 0, cv::INTER_AREA);
+    found = findBoard(small, board);
+    if (found) {
+      // Pixel centres: small pixel u covers full pixels around (u + 0.5) s - 0.5.
+      const float sx = static_cast<float>(gray.cols) / small.cols;
+      const float sy = static_cast<float>(gray.rows) / small.rows;
+      for (cv::Point2f& p : found->corners_px) {
+        p.x = (p.x + 0.5f) * sx - 0.5f;
+        p.y = (p.y + 0.5f) * sy - 0.5f;
+      }
+    }
+  }
+  if (!found) found = findBoard(gray, board);
+  if (!found) return std::nullopt;
+  Detection detection = std::move(*found);
   refineCorners(gray, detection.corners_px, board);
+  if (gridContinues(gray, detection.corners_px, board)) return std::nullopt;
   canonicalCornerOrder(detection.corners_px, board);
   const cv::Scalar horizontal =
       cv::estimateChessboardSharpness(gray, pattern, detection.corners_px, 0.8f, false);

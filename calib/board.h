@@ -66,10 +66,19 @@ struct Detection {
   double sharpness_px = 0.0;
 };
 
+struct DetectOptions {
+  // Images whose longer side exceeds this are searched at a scale that
+  // brings it to this size (ROS's camera_calibration searches at VGA size),
+  // and the corners refined at full resolution; if the board is not found
+  // there, the full image is searched too. 0: always full resolution.
+  int search_side_px = 640;
+};
+
 // Finds the whole board in an 8-bit grey or BGR(A) image; nothing when it is
 // not there. Throws std::invalid_argument for an empty image or another pixel
 // type, or an invalid board.
-std::optional<Detection> detectBoard(const cv::Mat& gray_or_bgr, const BoardSpec& board);
+std::optional<Detection> detectBoard(const cv::Mat& gray_or_bgr, const BoardSpec& board,
+                                     const DetectOptions& options = {});
 
 // Reorders a row-major grid so that views of one board agree: of the grid's
 // orderings that are rotations of it (the list reversed; for a square grid

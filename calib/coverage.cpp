@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -95,6 +96,8 @@ const char* refusalName(ViewRefusal refusal) {
       return "blurred";
     case ViewRefusal::kDuplicate:
       return "duplicate";
+    case ViewRefusal::kOtherSize:
+      return "other size";
   }
   return "unknown";
 }
@@ -117,6 +120,7 @@ ViewVerdict isGoodView(const std::optional<Detection>& detection, const BoardSpe
     }
   }
   std::ostringstream why;
+  why << std::fixed << std::setprecision(2);
   if (!(detection->sharpness_px <= options.max_sharpness_px)) {
     verdict.refusal = ViewRefusal::kBlurred;
     why << "blurred: edges rise over " << detection->sharpness_px << " px (at most "

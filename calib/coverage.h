@@ -80,6 +80,7 @@ enum class ViewRefusal {
   kNoBoard,    // no detection
   kBlurred,    // sharpness_px above max_sharpness_px
   kDuplicate,  // too close to kept view nearest_view
+  kOtherSize,  // the image's size is not the one of the views before it
 };
 const char* refusalName(ViewRefusal refusal);
 

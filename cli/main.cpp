@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   nadir::cli::addLogCommands(app);
   nadir::cli::addEvalCommand(app);
   nadir::cli::addVoCommands(app);
+  nadir::cli::addCalibCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -48,6 +48,10 @@ void ScenarioParams::visit(core::ParamVisitor& v) {
   for (NodeGroup& group : nodes) core::visitGroup(v, group.name, group.doc, group.params);
   core::visitGroup(v, "time", "how sim time runs", time);
   core::visitGroup(v, "bus", "where the streams go", bus);
+  core::visitGroup(v, "calibration",
+                   "the virtual checkerboard's views (nadir calib --virtual; world.kind "
+                   "checkerboard)",
+                   calibration);
 }
 
 std::map<std::string, camera::CameraSpec> ScenarioParams::allCameras() const {
@@ -86,6 +90,8 @@ ScenarioParams loadScenario(const std::string& name_or_path,
   const fs::path folder = fs::path(path).parent_path();
   terrain::resolvePathsFrom(params.world, folder.string());
   resolveRelative(params.sim.flight.path, folder);
+  resolveRelative(params.camera.calibration_file, folder);
+  for (auto& [name, spec] : params.cameras) resolveRelative(spec.calibration_file, folder);
   core::applyAssignments(params, overrides);
   return params;
 }

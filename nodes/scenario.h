@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "calib/virtual/virtual_board.h"
 #include "core/bus.h"
 #include "core/geodesy.h"
 #include "core/params.h"
@@ -53,6 +54,9 @@ struct ScenarioParams {
   std::vector<NodeGroup> nodes;
   sim::TimeParams time;
   core::BusParams bus;
+  // The poses the virtual checkerboard is seen from (nadir calib --virtual;
+  // world.kind checkerboard).
+  calib::VirtualViewParams calibration;
 
   void visit(core::ParamVisitor& v);
   // The main camera as "down" and the others under their names.

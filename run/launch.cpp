@@ -152,6 +152,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   nodes::ScenarioParams scenario = nodes::loadScenario(options.scenario, options.overrides);
   {
     // Refuse what nadir-sim would refuse before any process starts.
+    terrain::requireFlightWorld(scenario.world);
     const terrain::BuiltWorld built = terrain::makeWorld(scenario.world);
     sim::Simulator check(scenario.sim, built.world, core::LocalNedFrame(built.origin));
   }

@@ -23,6 +23,7 @@
 #include "run/process.h"
 #include "run/track_plot.h"
 #include "terrain/world.h"
+#include "terrain/world_factory.h"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -45,6 +46,7 @@ std::string defaultOutDir(const std::string& scenario) {
 RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress) {
   nodes::ScenarioParams scenario = nodes::loadScenario(options.scenario, options.overrides);
+  terrain::requireFlightWorld(scenario.world);
   // Everything stays in this process: the bus is in-process whatever the file says.
   scenario.bus.url = "memq://";
   // Byte-identical runs; set in the scenario so that scenario.yaml says what ran.

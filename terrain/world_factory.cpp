@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include <numbers>
+#include <stdexcept>
 
 #include "terrain/elevation.h"
 #include "terrain/geo_world.h"
@@ -95,6 +96,14 @@ void resolvePathsFrom(WorldParams& params, const std::string& folder) {
                             &params.imagery_green_path, &params.imagery_blue_path}) {
     if (path->empty() || std::filesystem::path(*path).is_absolute()) continue;
     *path = (std::filesystem::path(folder) / *path).lexically_normal().string();
+  }
+}
+
+void requireFlightWorld(const WorldParams& params) {
+  if (params.kind == "checkerboard") {
+    throw std::invalid_argument(
+        "world.kind is checkerboard: a calibration board a few decimetres across, not ground "
+        "to fly over; look at it with nadir calib --virtual");
   }
 }
 

@@ -49,6 +49,11 @@ struct BuiltWorld {
 // Throws TerrainError (files) or core::ParamError (bad values) naming what is wrong.
 BuiltWorld makeWorld(const WorldParams& params);
 
+// Throws std::invalid_argument when the world is not ground to fly or drive
+// over (a checkerboard world is a calibration board a few decimetres across:
+// nadir calib --virtual looks at it).
+void requireFlightWorld(const WorldParams& params);
+
 // Makes the world's relative file paths relative to `folder` (the folder of
 // the file that named them).
 void resolvePathsFrom(WorldParams& params, const std::string& folder);

@@ -50,6 +50,8 @@ std::vector<Eigen::Isometry3d> coveringPoses(const terrain::CheckerboardParams& 
 // south-west one (row along north, column along east).
 std::vector<Eigen::Vector3d> boardCorners_world(const terrain::CheckerboardWorld& world);
 
+// Its OpenGL context is made current on the constructing thread and stays
+// so: construct it and render on the same thread.
 class VirtualCheckerboard {
  public:
   // The camera's near and far planes are set from the poses' distances (a

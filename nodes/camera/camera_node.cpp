@@ -28,8 +28,9 @@ void CameraNode::onPose(const msg::Pose& pose) {
     // camera_info_t with the first frame, then once a second (and after a jump back).
     auto [last, first] = last_info_utime_.try_emplace(frame.name, pose.utime);
     if (first || pose.utime - last->second >= 1'000'000 || pose.utime < last->second) {
-      msg::publish(bus_, frame.spec->info_channel,
-                   cameraInfo(frame.name, *frame.spec, rig_.intrinsics(frame.name), pose.utime));
+      msg::publish(
+          bus_, frame.spec->info_channel,
+          cameraInfo(frame.name, *frame.spec, rig_.announcedIntrinsics(frame.name), pose.utime));
       last->second = pose.utime;
     }
     ++frames_;

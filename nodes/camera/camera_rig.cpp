@@ -6,6 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "calib/calibration_file.h"
 #include "core/frames.h"
 #include "core/hash.h"
 
@@ -26,6 +27,8 @@ void CameraSpec::visit(core::ParamVisitor& v) {
            .list_size = 3});
   v.field("jpeg_quality", &jpeg_quality,
           {.doc = "0 sends raw pixels, 1-100 JPEG of that quality", .min = 0, .max = 100});
+  v.field("calibration_file", &calibration_file,
+          {.doc = "calibration YAML (nadir calib) announced as the lens; empty: the true lens"});
   v.field("time_offset_s", &time_offset_s,
           {.doc = "stamp minus the true time of each frame, s", .min = -1, .max = 1});
   v.field("timestamp_jitter_s", &timestamp_jitter_s,
@@ -66,6 +69,7 @@ CameraRig::CameraRig(render::TerrainRenderer& terrain,
     Camera camera;
     camera.renderer = std::make_unique<render::CameraRenderer>(terrain, spec.camera);
     camera.half_span_us = core::utimeFromSeconds(spec.camera.motionHalfSpan_s());
+    if (!spec.calibration_file.empty()) camera.calibrated = readCalibratedLens(name, spec);
     if (camera.half_span_us > 0)
       history_span_us_ = std::max(history_span_us_, 2 * camera.half_span_us + 200000);
     cameras_.emplace(name, std::move(camera));
@@ -145,6 +149,28 @@ std::vector<CameraFrame> CameraRig::onPose(std::int64_t utime,
 
 const render::CameraIntrinsics& CameraRig::intrinsics(const std::string& name) const {
   return cameras_.at(name).renderer->intrinsics();
+}
+
+const render::CameraIntrinsics& CameraRig::announcedIntrinsics(const std::string& name) const {
+  const Camera& camera = cameras_.at(name);
+  return camera.calibrated ? *camera.calibrated : camera.renderer->intrinsics();
+}
+
+render::CameraIntrinsics readCalibratedLens(const std::string& name, const CameraSpec& spec) {
+  const std::string where = "camera " + name + ": calibration_file " + spec.calibration_file;
+  render::CameraIntrinsics lens;
+  try {
+    lens = calib::toCameraIntrinsics(calib::readCalibrationFile(spec.calibration_file));
+  } catch (const std::exception& error) {
+    throw std::runtime_error(where + ": " + error.what());
+  }
+  if (lens.width != spec.camera.width || lens.height != spec.camera.height) {
+    throw std::runtime_error(where + " is for " + std::to_string(lens.width) + "x" +
+                             std::to_string(lens.height) + " images, the camera makes " +
+                             std::to_string(spec.camera.width) + "x" +
+                             std::to_string(spec.camera.height));
+  }
+  return lens;
 }
 
 msg::CameraInfo cameraInfo(const std::string& name, const CameraSpec& spec,

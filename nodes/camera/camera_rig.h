@@ -7,6 +7,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,11 @@ struct CameraSpec {
   std::vector<double> mount_rpy_deg = {0.0, 0.0, 0.0};
   // 0 sends raw pixels; 1-100 sends JPEG of that quality (for thin links).
   int jpeg_quality = 0;
+  // A calibration file (OpenCV YAML, as nadir calib writes it): the lens the
+  // camera announces on its info channel instead of the one it renders with,
+  // as a real camera announces its calibration, not its true lens. Empty: the
+  // rendering lens.
+  std::string calibration_file;
   // Each frame's stamp is its true time plus time_offset_s (the camera's clock
   // against the body's) plus Gaussian jitter of timestamp_jitter_s (1 sigma,
   // cut at 3 sigma, from jitter_seed and the frame's time), s.
@@ -69,11 +75,15 @@ class CameraRig {
   void reset();
 
   const std::map<std::string, CameraSpec>& cameras() const { return specs_; }
+  // The lens a camera renders with.
   const render::CameraIntrinsics& intrinsics(const std::string& name) const;
+  // The lens it announces: its calibration_file's, or the rendering lens.
+  const render::CameraIntrinsics& announcedIntrinsics(const std::string& name) const;
 
  private:
   struct Camera {
     std::unique_ptr<render::CameraRenderer> renderer;
+    std::optional<render::CameraIntrinsics> calibrated;  // from calibration_file
     std::int64_t next_due_utime = core::kDueAtFirstCall;
     std::int64_t half_span_us = 0;
     std::deque<std::int64_t> waiting;  // due frames' utimes, waiting for later poses
@@ -93,6 +103,11 @@ class CameraRig {
   std::int64_t history_span_us_ = 0;
   std::int64_t last_utime_ = -1;
 };
+
+// The lens in a calibration file for a camera of this spec. Throws
+// std::runtime_error naming the file and the camera when it cannot be read,
+// is a fisheye calibration, or is for another image size than the camera's.
+render::CameraIntrinsics readCalibratedLens(const std::string& name, const CameraSpec& spec);
 
 // The camera_info_t of a camera of the rig: its lens and mount, stamped utime.
 msg::CameraInfo cameraInfo(const std::string& name, const CameraSpec& spec,

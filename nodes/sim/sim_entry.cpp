@@ -23,7 +23,7 @@ class SimLiveNode final : public Node {
  public:
   SimLiveNode(core::Bus& bus, const SimNodeParams& params)
       : params_(params),
-        built_(terrain::makeWorld(params.world)),
+        built_((terrain::requireFlightWorld(params.world), terrain::makeWorld(params.world))),
         frame_(built_.origin),
         simulator_(params.sim, built_.world, frame_,
                    sim::loadFlight(params.sim.flight, frame_, &flight_warning_)),

@@ -114,6 +114,28 @@ TEST(Scenario, BuiltInsLoad) {
   EXPECT_EQ(atterbury.sim.vehicle.altitude_agl_m, 300.0);
 }
 
+// The virtual checkerboard's scenario: the camera (1280 x 960, 84.872 deg,
+// k1 = -0.20, k2 = 0.05, noise on) over a 9x6 board; not ground to fly over.
+TEST(Scenario, CalibrationScenarioIsABoard) {
+  const ScenarioParams calibration = loadScenario("calibration");
+  EXPECT_EQ(calibration.world.kind, "checkerboard");
+  EXPECT_EQ(calibration.world.checkerboard.inner_cols, 9);
+  EXPECT_EQ(calibration.world.checkerboard.inner_rows, 6);
+  EXPECT_DOUBLE_EQ(calibration.world.checkerboard.square_m, 0.025);
+  EXPECT_EQ(calibration.camera.camera.width, 1280);
+  EXPECT_DOUBLE_EQ(calibration.camera.camera.distortion[0], -0.20);
+  EXPECT_DOUBLE_EQ(calibration.camera.camera.distortion[1], 0.05);
+  EXPECT_GT(calibration.camera.camera.read_noise_counts, 0.0);
+  EXPECT_EQ(calibration.calibration.views, 60);
+  try {
+    terrain::requireFlightWorld(calibration.world);
+    ADD_FAILURE() << "a checkerboard world was taken for ground to fly over";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("nadir calib --virtual"), std::string::npos);
+  }
+  EXPECT_NO_THROW(terrain::requireFlightWorld(loadScenario("default").world));
+}
+
 // The effective scenario a run writes (scenario.yaml) loads back to the same
 // parameters, for every built-in scenario.
 TEST(Scenario, FormattedScenarioLoadsBack) {

@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "calib/calibration_file.h"
 #include "nodes/camera/camera_rig.h"
 #include "render/egl_context.h"
 #include "terrain/checkerboard_world.h"
@@ -199,6 +200,72 @@ TEST(CameraRig, CameraInfoCarriesIntrinsicsAndMount) {
   EXPECT_NEAR(info.q_body_cam.w(), std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(info.q_body_cam.z(), std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(info.q_body_cam.x(), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace nadir::camera
+
+namespace nadir::camera {
+namespace {
+
+std::string writeLens(const std::string& name, int width, int height, calib::LensModel model) {
+  calib::CalibrationFile file;
+  file.model = model;
+  file.image_width = width;
+  file.image_height = height;
+  file.camera_matrix = cv::Matx33d(50.5, 0, 31.25, 0, 50.25, 23.75, 0, 0, 1);
+  file.distortion = model == calib::LensModel::kFisheye
+                        ? std::vector<double>{0.1, 0.01, 0, 0}
+                        : std::vector<double>{-0.1, 0.02, 0.001, -0.002, 0.0};
+  const std::string path = ::testing::TempDir() + "nadir_rig_" + name + ".yaml";
+  calib::writeCalibrationFile(path, file);
+  return path;
+}
+
+// With a calibration file the rig renders with its true lens but announces
+// the file's, as a real camera announces its calibration.
+TEST(CameraRig, CalibrationFileIsTheAnnouncedLens) {
+  CameraSpec spec = smallCamera(10.0);
+  spec.calibration_file = writeLens("good", 64, 48, calib::LensModel::kRadtan);
+  Rig rig({{"down", spec}});
+  const render::CameraIntrinsics& rendered = rig.rig->intrinsics("down");
+  const render::CameraIntrinsics& announced = rig.rig->announcedIntrinsics("down");
+  EXPECT_FALSE(rendered.hasDistortion());
+  EXPECT_DOUBLE_EQ(announced.fx, 50.5);
+  EXPECT_DOUBLE_EQ(announced.fy, 50.25);
+  EXPECT_DOUBLE_EQ(announced.cx, 31.25);
+  EXPECT_DOUBLE_EQ(announced.cy, 23.75);
+  EXPECT_DOUBLE_EQ(announced.distortion[0], -0.1);
+  EXPECT_DOUBLE_EQ(announced.distortion[3], -0.002);
+  const msg::CameraInfo info = cameraInfo("down", spec, announced, 7);
+  EXPECT_DOUBLE_EQ(info.fx, 50.5);
+  EXPECT_EQ(info.distortion_model, msg::Distortion::RADTAN);
+  // Without a file the announced lens is the rendering one.
+  Rig plain({{"down", smallCamera(10.0)}});
+  EXPECT_DOUBLE_EQ(plain.rig->announcedIntrinsics("down").fx, plain.rig->intrinsics("down").fx);
+}
+
+// A file for another image size, a fisheye file and a missing file are
+// refused, naming the camera and the file.
+TEST(CameraRig, WrongCalibrationFileIsRefused) {
+  auto errorOf = [](const std::string& path) {
+    CameraSpec spec = smallCamera(10.0);
+    spec.calibration_file = path;
+    try {
+      Rig rig({{"down", spec}});
+    } catch (const std::runtime_error& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  const std::string wrong_size = errorOf(writeLens("big", 640, 480, calib::LensModel::kRadtan));
+  EXPECT_NE(wrong_size.find("camera down: calibration_file"), std::string::npos) << wrong_size;
+  EXPECT_NE(wrong_size.find("is for 640x480 images, the camera makes 64x48"), std::string::npos)
+      << wrong_size;
+  const std::string fisheye = errorOf(writeLens("fisheye", 64, 48, calib::LensModel::kFisheye));
+  EXPECT_NE(fisheye.find("fisheye"), std::string::npos) << fisheye;
+  const std::string missing = errorOf("/nonexistent/lens.yaml");
+  EXPECT_NE(missing.find("/nonexistent/lens.yaml"), std::string::npos) << missing;
 }
 
 }  // namespace
