@@ -33,3 +33,7 @@ if [[ -d "$root/out/thesis-oscillating" ]]; then
   (cd "$root" && QT_QPA_PLATFORM=offscreen build/bin/nadir-plot out --run thesis-oscillating \
     --figure top_view --screenshot "$out/nadir_plot_window.png")
 fi
+
+# The calibration window after the virtual checkerboard's 60 views.
+QT_QPA_PLATFORM=offscreen "$root/build/bin/nadir-calib" --virtual \
+  --screenshot "$out/nadir_calib.png" >/dev/null
