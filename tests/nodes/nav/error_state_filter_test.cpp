@@ -1,0 +1,227 @@
+// The navigation filter's core against motion and covariance worked out by
+// hand: a vehicle at rest, a path of constant acceleration while turning, and
+// the barometer and rangefinder updates.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "nodes/nav/error_state_filter.h"
+
+namespace nadir::nav {
+namespace {
+
+constexpr double kDt = 1.0 / 200.0;
+constexpr std::int64_t kDtUs = 5000;
+
+Covariance zeroCovariance() { return Covariance::Zero(); }
+
+// At rest and level, with readings free of noise and bias: the state does not
+// move, and the covariance grows as the IMU's noise says. Worked out from the
+// error equations: dv_z' = n_a, so var(v_z) = q_a T and var(p_z) = q_a T^3 / 3;
+// horizontally a tilt error dtheta (a random walk of q_g) tips gravity into the
+// velocity, dv_x' = -g dtheta_y + n_a, so var(v_x) = q_a T + g^2 q_g T^3 / 3 and
+// var(p_x) = q_a T^3 / 3 + g^2 q_g T^5 / 20.
+TEST(ErrorStateFilter, AtRestItStaysPutAndItsCovarianceGrowsAsTheNoiseSays) {
+  ProcessNoise noise;
+  noise.gyro_bias_random_walk_rps_rts = 0.0;
+  noise.accel_bias_random_walk_mps2_rts = 0.0;
+  NavState start;
+  start.p_ned_m = Eigen::Vector3d(10.0, -20.0, -100.0);
+  ErrorStateFilter filter(noise, start, zeroCovariance());
+  ImuSample imu;
+  imu.linear_acceleration_mps2 = Eigen::Vector3d(0.0, 0.0, -kGravity_mps2);
+  const double T = 10.0;
+  for (int i = 0; i <= static_cast<int>(T / kDt); ++i) {
+    imu.utime = 1'000'000 + i * kDtUs;
+    filter.propagate(imu);
+  }
+  const NavState& s = filter.state();
+  EXPECT_NEAR((s.p_ned_m - start.p_ned_m).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(s.v_ned_mps.norm(), 0.0, 1e-9);
+  EXPECT_NEAR(s.q_world_body.angularDistance(Eigen::Quaterniond::Identity()), 0.0, 1e-12);
+
+  const double q_a = std::pow(noise.accel_noise_density_mps2_rthz, 2);
+  const double q_g = std::pow(noise.gyro_noise_density_rps_rthz, 2);
+  const double g2 = kGravity_mps2 * kGravity_mps2;
+  const Covariance& P = filter.covariance();
+  EXPECT_NEAR(P(idx::kV + 2, idx::kV + 2) / (q_a * T), 1.0, 0.01);
+  EXPECT_NEAR(P(idx::kP + 2, idx::kP + 2) / (q_a * T * T * T / 3), 1.0, 0.01);
+  for (int axis = 0; axis < 2; ++axis) {
+    EXPECT_NEAR(P(idx::kV + axis, idx::kV + axis) / (q_a * T + g2 * q_g * T * T * T / 3), 1.0,
+                0.01);
+    EXPECT_NEAR(
+        P(idx::kP + axis, idx::kP + axis) / (q_a * T * T * T / 3 + g2 * q_g * std::pow(T, 5) / 20),
+        1.0, 0.01);
+    EXPECT_NEAR(P(idx::kTheta + axis, idx::kTheta + axis) / (q_g * T), 1.0, 0.01);
+  }
+}
+
+// A path of constant acceleration in the world while the body turns at a
+// constant rate, its IMU readings worked out exactly (specific force = R^T (a -
+// g)), no noise: after 20 s the position is within 1 cm of p0 + v0 t + a t^2 / 2.
+TEST(ErrorStateFilter, ConstantAccelerationWhileTurningWithin1Cm) {
+  const Eigen::Vector3d p0(0.0, 0.0, -50.0), v0(20.0, 5.0, 0.0), a(0.4, -0.3, 0.05);
+  const Eigen::Vector3d omega_body(0.02, -0.01, 0.1);
+  NavState start;
+  start.p_ned_m = p0;
+  start.v_ned_mps = v0;
+  ErrorStateFilter filter(ProcessNoise{}, start, zeroCovariance());
+  const Eigen::Vector3d g(0.0, 0.0, kGravity_mps2);
+  const double T = 20.0;
+  const int steps = static_cast<int>(T / kDt);
+  for (int i = 0; i <= steps; ++i) {
+    const double t = i * kDt;
+    ImuSample imu;
+    imu.utime = i * kDtUs;
+    imu.angular_velocity_rps = omega_body;
+    // The specific force at the middle of the interval that ends at t, as the
+    // filter takes each sample to hold over the interval before it.
+    const double t_mid = std::max(0.0, t - 0.5 * kDt);
+    const Eigen::Quaterniond q_mid(
+        Eigen::AngleAxisd(omega_body.norm() * t_mid, omega_body.normalized()));
+    imu.linear_acceleration_mps2 = q_mid.inverse() * (a - g);
+    filter.propagate(imu);
+  }
+  const Eigen::Vector3d expected = p0 + v0 * T + 0.5 * a * T * T;
+  EXPECT_LT((filter.state().p_ned_m - expected).norm(), 0.01);
+  EXPECT_LT((filter.state().v_ned_mps - (v0 + a * T)).norm(), 0.001);
+  const Eigen::Quaterniond q_end(Eigen::AngleAxisd(omega_body.norm() * T, omega_body.normalized()));
+  EXPECT_LT(filter.state().q_world_body.angularDistance(q_end), 1e-9);
+}
+
+// A gyro bias the filter does not know (0.002 rad/s about roll and -0.0015
+// about pitch, the IMU at rest, GPS position and velocity at 5 Hz): the filter
+// learns it as fast as its own covariance says it can. At every GPS fix the
+// error is inside 3 of the filter's sigma, and once that sigma is below a
+// tenth of the bias, so is the error (to 3 sigma).
+TEST(ErrorStateFilter, GyroBiasIsLearntAsFastAsTheCovarianceSays) {
+  const Eigen::Vector3d true_bias(0.002, -0.0015, 0.0);
+  NavState start;
+  Covariance P = Covariance::Zero();
+  P.block<3, 3>(idx::kP, idx::kP) = Eigen::Matrix3d::Identity() * 1.0;
+  P.block<3, 3>(idx::kV, idx::kV) = Eigen::Matrix3d::Identity() * 0.01;
+  P.block<3, 3>(idx::kTheta, idx::kTheta) = Eigen::Matrix3d::Identity() * 1e-4;
+  P.block<3, 3>(idx::kGyroBias, idx::kGyroBias) = Eigen::Matrix3d::Identity() * 1e-4;  // 0.01 rad/s
+  P.block<3, 3>(idx::kAccelBias, idx::kAccelBias) = Eigen::Matrix3d::Identity() * 1e-4;
+  P(idx::kBaroBias, idx::kBaroBias) = 1.0;
+  P(idx::kGround, idx::kGround) = 1.0;
+  ErrorStateFilter filter(ProcessNoise{}, start, P);
+  ImuSample imu;
+  imu.angular_velocity_rps = true_bias;
+  imu.linear_acceleration_mps2 = Eigen::Vector3d(0.0, 0.0, -kGravity_mps2);
+  const Eigen::Matrix3d gps_p = Eigen::Matrix3d::Identity() * 0.25;
+  const Eigen::Matrix3d gps_v = Eigen::Matrix3d::Identity() * 0.0025;
+  bool learnt = false;
+  for (int i = 0; i <= 200 * 300; ++i) {
+    imu.utime = i * kDtUs;
+    filter.propagate(imu);
+    if (i % 40 != 0) continue;
+    filter.updatePosition(Eigen::Vector3d::Zero(), gps_p);
+    filter.updateVelocity(Eigen::Vector3d::Zero(), gps_v);
+    for (int axis = 0; axis < 2; ++axis) {
+      const double sigma =
+          std::sqrt(filter.covariance()(idx::kGyroBias + axis, idx::kGyroBias + axis));
+      const double error = filter.state().gyro_bias_rps[axis] - true_bias[axis];
+      ASSERT_LT(std::abs(error), 3.0 * sigma) << "axis " << axis << " at " << i * kDt << " s";
+      if (sigma < 0.1 * std::abs(true_bias[axis])) {
+        learnt = true;
+        EXPECT_LT(std::abs(error), 0.3 * std::abs(true_bias[axis])) << "axis " << axis;
+      }
+    }
+  }
+  EXPECT_TRUE(learnt) << "the roll and pitch biases are observable at rest with GPS velocity";
+  EXPECT_NEAR(filter.state().gyro_bias_rps.x(), true_bias.x(), 2e-4);
+  EXPECT_NEAR(filter.state().gyro_bias_rps.y(), true_bias.y(), 2e-4);
+}
+
+// The barometer alone cannot tell the height from its own bias: after one
+// reading the height moves by the share of the innovation its variance holds,
+// worked out by hand for one scalar update (gain = P_h / (P_h + P_b + r^2)).
+TEST(ErrorStateFilter, BaroUpdateSplitsTheInnovationByVariance) {
+  NavState start;
+  start.p_ned_m = Eigen::Vector3d(0.0, 0.0, -100.0);  // 100 m above the origin
+  Covariance P = Covariance::Identity() * 1e-6;
+  P(idx::kP + 2, idx::kP + 2) = 4.0;  // 2 m
+  P(idx::kBaroBias, idx::kBaroBias) = 1.0;
+  ErrorStateFilter filter(ProcessNoise{}, start, P);
+  const UpdateResult r = filter.updateBaro(500.0 + 103.0, 500.0, 1.0);  // reads 3 m higher
+  ASSERT_TRUE(r.accepted);
+  // Innovation 3 m, S = 4 + 1 + 1 = 6: NIS 1.5; the height takes 4/6 of it, the bias 1/6.
+  EXPECT_NEAR(r.nis, 9.0 / 6.0, 1e-6);
+  EXPECT_NEAR(-filter.state().p_ned_m.z(), 100.0 + 3.0 * 4.0 / 6.0, 1e-6);
+  EXPECT_NEAR(filter.state().baro_bias_m, 3.0 * 1.0 / 6.0, 1e-6);
+}
+
+// A rangefinder looking 30 deg off the vertical (the body rolled) reads
+// height / cos(30 deg); with the ground as a state and the height known, the
+// ground moves to where the range puts it.
+TEST(ErrorStateFilter, RangeAlongATiltedBeamFindsTheGround) {
+  NavState start;
+  start.p_ned_m = Eigen::Vector3d(0.0, 0.0, -80.0);
+  start.q_world_body =
+      Eigen::Quaterniond(Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+  start.ground_down_m = 0.0;
+  Covariance P = Covariance::Identity() * 1e-8;
+  P(idx::kGround, idx::kGround) = 100.0;
+  ErrorStateFilter filter(ProcessNoise{}, start, P);
+  // The ground is really 20 m higher (down -20): height 60 m, range 60 / cos 30.
+  const double range = 60.0 / std::cos(30.0 * M_PI / 180.0);
+  const UpdateResult r = filter.updateRange(range, Eigen::Vector3d::UnitZ(), 0.01);
+  ASSERT_TRUE(r.accepted);
+  EXPECT_NEAR(filter.state().ground_down_m, -20.0, 0.01);
+  EXPECT_NEAR(filter.state().p_ned_m.z(), -80.0, 1e-3);
+  // With a map of the ground instead, the range moves the height.
+  Covariance P2 = Covariance::Identity() * 1e-8;
+  P2(idx::kP + 2, idx::kP + 2) = 900.0;  // 30 m: the 40 m jump is inside the gate
+  ErrorStateFilter mapped(ProcessNoise{}, start, P2);
+  ASSERT_TRUE(
+      mapped.updateRange(range, Eigen::Vector3d::UnitZ(), 0.01, [](double, double) { return 20.0; })
+          .accepted);
+  // Ground at down +20: the vehicle is 60 m above it, at down -40.
+  EXPECT_NEAR(mapped.state().p_ned_m.z(), -40.0, 0.01);
+}
+
+// A reading far outside what the covariance allows is refused and changes nothing.
+TEST(ErrorStateFilter, GateRefusesAnOutlier) {
+  NavState start;
+  Covariance P = Covariance::Identity() * 0.01;
+  ErrorStateFilter filter(ProcessNoise{}, start, P);
+  const UpdateResult r =
+      filter.updatePosition(Eigen::Vector3d(50.0, 0.0, 0.0), Eigen::Matrix3d::Identity());
+  EXPECT_FALSE(r.accepted);
+  EXPECT_GT(r.nis, 1000.0);
+  EXPECT_EQ(filter.state().p_ned_m, Eigen::Vector3d::Zero());
+  EXPECT_EQ(filter.covariance(), P);
+}
+
+// Chi-square quantiles against the tables: 3.841 (95 %, 1), 7.815 (95 %, 3),
+// 11.345 (99 %, 3), 0.352 (5 %, 3).
+TEST(ErrorStateFilter, ChiSquareQuantiles) {
+  EXPECT_NEAR(chiSquareQuantile(0.95, 1), 3.841, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.95, 3), 7.815, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.99, 3), 11.345, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.05, 3), 0.352, 1e-3);
+}
+
+// Bad input: a covariance that is not symmetric, a negative noise figure, an
+// IMU sample going back in time.
+TEST(ErrorStateFilter, BadInput) {
+  Covariance asymmetric = Covariance::Identity();
+  asymmetric(0, 1) = 1.0;
+  EXPECT_THROW(ErrorStateFilter(ProcessNoise{}, NavState{}, asymmetric), std::invalid_argument);
+  ProcessNoise negative;
+  negative.gyro_noise_density_rps_rthz = -1.0;
+  EXPECT_THROW(ErrorStateFilter(negative, NavState{}, Covariance::Identity()),
+               std::invalid_argument);
+  ErrorStateFilter filter(ProcessNoise{}, NavState{}, Covariance::Identity());
+  ImuSample imu;
+  imu.utime = 100;
+  filter.propagate(imu);
+  imu.utime = 50;
+  EXPECT_THROW(filter.propagate(imu), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace nadir::nav
