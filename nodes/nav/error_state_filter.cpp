@@ -236,4 +236,26 @@ UpdateResult ErrorStateFilter::updateRange(double range_m, const Eigen::Vector3d
                    Eigen::Matrix<double, 1, 1>(sigma_m * sigma_m));
 }
 
+UpdateResult ErrorStateFilter::updateHeading(const Eigen::Vector3d& field_body_ut,
+                                             const Eigen::Vector3d& field_world_ut,
+                                             double sigma_rad) {
+  UpdateResult refused;
+  refused.dimension = 1;
+  const Eigen::Matrix3d R = state_.q_world_body.toRotationMatrix();
+  const Eigen::Vector3d measured_world = R * field_body_ut;
+  if (measured_world.head<2>().norm() < 0.1 * measured_world.norm() ||
+      field_world_ut.head<2>().norm() < 0.1 * field_world_ut.norm())
+    return refused;
+  // A heading error e (true = Rz(e) R) turns the measured field by -e in the world.
+  const double expected = std::atan2(field_world_ut.y(), field_world_ut.x());
+  const double seen = std::atan2(measured_world.y(), measured_world.x());
+  double residual = expected - seen;
+  residual = std::atan2(std::sin(residual), std::cos(residual));
+  Eigen::Matrix<double, 1, kStates> H = Eigen::Matrix<double, 1, kStates>::Zero();
+  // A body-frame angle error turns the heading by its world z component.
+  H.block<1, 3>(0, idx::kTheta) = R.row(2);
+  return update<1>(Eigen::Matrix<double, 1, 1>(residual), H,
+                   Eigen::Matrix<double, 1, 1>(sigma_rad * sigma_rad));
+}
+
 }  // namespace nadir::nav

@@ -98,6 +98,15 @@ class ErrorStateFilter {
   UpdateResult updateRange(double range_m, const Eigen::Vector3d& direction_body, double sigma_m,
                            const GroundDown& ground_down = {});
 
+  // The heading a magnetometer gives: the measured field turned into the
+  // world by the estimated attitude, against the Earth's field there
+  // (field_world_ut, NED), compared in the horizontal plane only, so that a
+  // hard-iron offset or a disturbed field cannot tilt the estimate.
+  // sigma_rad is the heading's 1-sigma. Refused when either horizontal
+  // component is under a tenth of its vector (near the magnetic poles).
+  UpdateResult updateHeading(const Eigen::Vector3d& field_body_ut,
+                             const Eigen::Vector3d& field_world_ut, double sigma_rad);
+
   // Innovations whose NIS exceeds the chi-square quantile of this probability
   // for their dimension are refused. 1 = no gate.
   void setGateProbability(double probability);

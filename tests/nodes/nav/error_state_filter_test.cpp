@@ -183,6 +183,46 @@ TEST(ErrorStateFilter, RangeAlongATiltedBeamFindsTheGround) {
   EXPECT_NEAR(mapped.state().p_ned_m.z(), -40.0, 0.01);
 }
 
+// The magnetometer's heading: a filter that believes it heads 10 deg more to
+// the east than it does turns back to the truth about the world's vertical with
+// one reading of a tight sigma. A hard-iron offset (3 uT along the body's down
+// axis, the body pitched 5 deg) turns the heading it gives, by about
+// atan(3 sin 5 deg / 20.7 uT horizontal) = 0.7 deg, but leaves roll and pitch
+// alone.
+TEST(ErrorStateFilter, HeadingFromTheMagnetometerTurnsOnlyTheYaw) {
+  const Eigen::Quaterniond truth(Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(5.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  // Declination -4.6 deg, inclination 66.5 deg, 52 uT (sim::MagnetometerParams).
+  const double dec = -4.6 * M_PI / 180.0, inc = 66.5 * M_PI / 180.0;
+  const Eigen::Vector3d field_world =
+      52.0 *
+      Eigen::Vector3d(std::cos(inc) * std::cos(dec), std::cos(inc) * std::sin(dec), std::sin(inc));
+  for (const double hard_iron_ut : {0.0, 3.0}) {
+    NavState start;
+    start.q_world_body =
+        Eigen::Quaterniond(Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ())) *
+        truth;
+    Covariance P = Covariance::Identity() * 1e-6;
+    P.block<3, 3>(idx::kTheta, idx::kTheta) = Eigen::Matrix3d::Identity() * 0.1;  // 18 deg
+    ErrorStateFilter filter(ProcessNoise{}, start, P);
+    const Eigen::Vector3d field_body =
+        truth.inverse() * field_world + Eigen::Vector3d(0, 0, hard_iron_ut);
+    ASSERT_TRUE(filter.updateHeading(field_body, field_world, 1e-4).accepted);
+    const Eigen::Vector3d ypr_est =
+        filter.state().q_world_body.toRotationMatrix().eulerAngles(2, 1, 0);
+    const Eigen::Vector3d ypr_true = truth.toRotationMatrix().eulerAngles(2, 1, 0);
+    const double yaw_error_deg = (ypr_est[0] - ypr_true[0]) * 180.0 / M_PI;
+    if (hard_iron_ut == 0.0) {
+      EXPECT_NEAR(yaw_error_deg, 0.0, 0.01);
+    } else {
+      EXPECT_GT(std::abs(yaw_error_deg), 0.3);
+      EXPECT_LT(std::abs(yaw_error_deg), 1.0);
+    }
+    EXPECT_NEAR(ypr_est[1], ypr_true[1], 1e-6) << "pitch, hard iron " << hard_iron_ut;
+    EXPECT_NEAR(ypr_est[2], ypr_true[2], 1e-6) << "roll, hard iron " << hard_iron_ut;
+  }
+}
+
 // A reading far outside what the covariance allows is refused and changes nothing.
 TEST(ErrorStateFilter, GateRefusesAnOutlier) {
   NavState start;
