@@ -76,7 +76,8 @@ ErrorStateFilter::ErrorStateFilter(const ProcessNoise& noise, const NavState& in
   for (const double figure :
        {noise.gyro_noise_density_rps_rthz, noise.accel_noise_density_mps2_rthz,
         noise.gyro_bias_random_walk_rps_rts, noise.accel_bias_random_walk_mps2_rts,
-        noise.baro_bias_random_walk_m_rts, noise.ground_random_walk_m_rtm}) {
+        noise.baro_bias_random_walk_m_rts, noise.ground_random_walk_m_rtm,
+        noise.vo_log_scale_random_walk_rts}) {
     if (!(figure >= 0.0) || !std::isfinite(figure))
       throw std::invalid_argument("the filter's process noise must be finite and >= 0");
   }
@@ -140,6 +141,7 @@ void ErrorStateFilter::propagate(const ImuSample& imu) {
   q.segment<3>(idx::kAccelBias).setConstant(square(noise_.accel_bias_random_walk_mps2_rts) * dt);
   q(idx::kBaroBias) = square(noise_.baro_bias_random_walk_m_rts) * dt;
   q(idx::kGround) = square(noise_.ground_random_walk_m_rtm) * horizontal_speed * dt;
+  q(idx::kLogScale) = square(noise_.vo_log_scale_random_walk_rts) * dt;
   P_ = F * P_ * F.transpose();
   P_.diagonal() += q;
   P_ = 0.5 * (P_ + P_.transpose());
@@ -153,9 +155,9 @@ UpdateResult ErrorStateFilter::update(const Eigen::Matrix<double, M, 1>& residua
   result.dimension = M;
   const Eigen::Matrix<double, kStates, M> PHt = P_ * H.transpose();
   const Eigen::Matrix<double, M, M> S = H * PHt + R;
-  // M is 1 or 3: a fixed-size inverse, after checking S is positive definite.
+  // M is at most 6: a fixed-size inverse, after checking S is positive definite.
   if (!residual.allFinite() || !S.allFinite() || S.llt().info() != Eigen::Success) return result;
-  const Eigen::Matrix<double, M, M> S_inv = S.inverse();
+  const Eigen::Matrix<double, M, M> S_inv = S.llt().solve(Eigen::Matrix<double, M, M>::Identity());
   result.nis = residual.dot(S_inv * residual);
   if (gate_probability_ < 1.0 && result.nis > chiSquareQuantile(gate_probability_, M))
     return result;
@@ -177,9 +179,15 @@ void ErrorStateFilter::inject(const Eigen::Matrix<double, kStates, 1>& dx) {
   state_.accel_bias_mps2 += dx.segment<3>(idx::kAccelBias);
   state_.baro_bias_m += dx(idx::kBaroBias);
   state_.ground_down_m += dx(idx::kGround);
+  state_.clone_p_ned_m += dx.segment<3>(idx::kCloneP);
+  const Eigen::Vector3d dtheta_clone = dx.segment<3>(idx::kCloneTheta);
+  state_.clone_q_world_body =
+      (state_.clone_q_world_body * expQuaternion(dtheta_clone)).normalized();
+  state_.vo_log_scale += dx(idx::kLogScale);
   // The covariance of the error about the new nominal state (Sola 2017, 7.2).
   Covariance G = Covariance::Identity();
   G.block<3, 3>(idx::kTheta, idx::kTheta) -= skew(0.5 * dtheta);
+  G.block<3, 3>(idx::kCloneTheta, idx::kCloneTheta) -= skew(0.5 * dtheta_clone);
   P_ = G * P_ * G.transpose();
   P_ = 0.5 * (P_ + P_.transpose());
 }
@@ -234,6 +242,45 @@ UpdateResult ErrorStateFilter::updateRange(double range_m, const Eigen::Vector3d
   H.block<1, 3>(0, idx::kTheta) = -height / (c * c) * dc_dtheta;
   return update<1>(Eigen::Matrix<double, 1, 1>(range_m - height / c), H,
                    Eigen::Matrix<double, 1, 1>(sigma_m * sigma_m));
+}
+
+void ErrorStateFilter::cloneCurrentPose() {
+  state_.clone_p_ned_m = state_.p_ned_m;
+  state_.clone_q_world_body = state_.q_world_body;
+  // The clone's error is the present pose's: its rows and columns copied.
+  Covariance J = Covariance::Identity();
+  J.block<3, 3>(idx::kCloneP, idx::kCloneP).setZero();
+  J.block<3, 3>(idx::kCloneTheta, idx::kCloneTheta).setZero();
+  J.block<3, 3>(idx::kCloneP, idx::kP).setIdentity();
+  J.block<3, 3>(idx::kCloneTheta, idx::kTheta).setIdentity();
+  P_ = J * P_ * J.transpose();
+  P_ = 0.5 * (P_ + P_.transpose());
+}
+
+UpdateResult ErrorStateFilter::updateRelativePose(const Eigen::Vector3d& dp_clone_body,
+                                                  const Eigen::Quaterniond& dq_clone_body,
+                                                  const Eigen::Matrix<double, 6, 6>& covariance) {
+  const Eigen::Matrix3d R_clone = state_.clone_q_world_body.toRotationMatrix();
+  const Eigen::Matrix3d R = state_.q_world_body.toRotationMatrix();
+  const double scale = std::exp(state_.vo_log_scale);
+  const Eigen::Vector3d d_clone = R_clone.transpose() * (state_.p_ned_m - state_.clone_p_ned_m);
+  const Eigen::Matrix3d dR_predicted = R_clone.transpose() * R;
+  Eigen::Matrix<double, 6, 1> residual;
+  residual.head<3>() = dp_clone_body - scale * d_clone;
+  // The rotation's residual as a small angle in the present body frame.
+  const Eigen::AngleAxisd rotation_residual(Eigen::Quaterniond(dR_predicted).conjugate() *
+                                            dq_clone_body.normalized());
+  residual.tail<3>() = rotation_residual.angle() * rotation_residual.axis();
+  Eigen::Matrix<double, 6, kStates> H = Eigen::Matrix<double, 6, kStates>::Zero();
+  H.block<3, 3>(0, idx::kP) = scale * R_clone.transpose();
+  H.block<3, 3>(0, idx::kCloneP) = -scale * R_clone.transpose();
+  // R_clone_true^T = Exp(-dtheta_c) R_clone^T: the clone's angle turns d_clone.
+  H.block<3, 3>(0, idx::kCloneTheta) = scale * skew(d_clone);
+  H.block<3, 1>(0, idx::kLogScale) = scale * d_clone;
+  // dR_true = dR_predicted Exp(dtheta - dR_predicted^T dtheta_c), to first order.
+  H.block<3, 3>(3, idx::kTheta).setIdentity();
+  H.block<3, 3>(3, idx::kCloneTheta) = -dR_predicted.transpose();
+  return update<6>(residual, H, covariance);
 }
 
 UpdateResult ErrorStateFilter::updateHeading(const Eigen::Vector3d& field_body_ut,

@@ -18,8 +18,10 @@ namespace nadir::nav {
 inline constexpr double kGravity_mps2 = 9.80665;
 
 // The error state: position, velocity, attitude (local, body frame), gyro and
-// accelerometer biases, barometer bias, ground height (down coordinate).
-inline constexpr int kStates = 17;
+// accelerometer biases, barometer bias, ground height (down coordinate), a
+// clone of the pose at the last VO frame (stochastic cloning), and the VO's
+// log scale.
+inline constexpr int kStates = 24;
 namespace idx {
 inline constexpr int kP = 0;
 inline constexpr int kV = 3;
@@ -28,6 +30,9 @@ inline constexpr int kGyroBias = 9;
 inline constexpr int kAccelBias = 12;
 inline constexpr int kBaroBias = 15;
 inline constexpr int kGround = 16;
+inline constexpr int kCloneP = 17;
+inline constexpr int kCloneTheta = 20;
+inline constexpr int kLogScale = 23;
 }  // namespace idx
 
 using Covariance = Eigen::Matrix<double, kStates, kStates>;
@@ -43,6 +48,11 @@ struct NavState {
   double baro_bias_m = 0.0;
   // The ground under the vehicle, down coordinate in the world frame, m.
   double ground_down_m = 0.0;
+  // The pose at the last VO frame (cloneCurrentPose), world frame.
+  Eigen::Vector3d clone_p_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond clone_q_world_body = Eigen::Quaterniond::Identity();
+  // The VO's distances are exp(vo_log_scale) times the true ones.
+  double vo_log_scale = 0.0;
 };
 
 // Process noise, in the IMU's datasheet units (as sim::ImuParams).
@@ -55,6 +65,8 @@ struct ProcessNoise {
   // How the ground's height wanders as the vehicle flies over it, m per
   // sqrt(m) flown horizontally.
   double ground_random_walk_m_rtm = 0.1;
+  // How the VO's scale wanders, per sqrt(s) of log scale.
+  double vo_log_scale_random_walk_rts = 1e-3;
 };
 
 struct ImuSample {
@@ -106,6 +118,18 @@ class ErrorStateFilter {
   // component is under a tenth of its vector (near the magnetic poles).
   UpdateResult updateHeading(const Eigen::Vector3d& field_body_ut,
                              const Eigen::Vector3d& field_world_ut, double sigma_rad);
+
+  // Takes the present pose as the clone: the pose a VO's next relative pose
+  // starts from. Called at each VO frame after its update, and at a VO's first
+  // frame or after its reset (no update then, so nothing jumps).
+  void cloneCurrentPose();
+  // A VO's motion from the cloned pose to the present one, in the cloned body
+  // frame: dp_body (VO scale) = exp(log scale) R_clone^T (p - p_clone), and
+  // dR = R_clone^T R, with their covariance (translation first, then the
+  // rotation's small angle, body frame).
+  UpdateResult updateRelativePose(const Eigen::Vector3d& dp_clone_body,
+                                  const Eigen::Quaterniond& dq_clone_body,
+                                  const Eigen::Matrix<double, 6, 6>& covariance);
 
   // Innovations whose NIS exceeds the chi-square quantile of this probability
   // for their dimension are refused. 1 = no gate.

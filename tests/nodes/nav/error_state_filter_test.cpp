@@ -136,6 +136,59 @@ TEST(ErrorStateFilter, GyroBiasIsLearntAsFastAsTheCovarianceSays) {
   EXPECT_NEAR(filter.state().gyro_bias_rps.y(), true_bias.y(), 2e-4);
 }
 
+// The path of ConstantAccelerationWhileTurning, worked out exactly at t.
+struct TurningPath {
+  Eigen::Vector3d p0{0.0, 0.0, -50.0}, v0{20.0, 5.0, 0.0}, a{0.4, -0.3, 0.05};
+  Eigen::Vector3d omega_body{0.02, -0.01, 0.1};
+  Eigen::Vector3d p(double t) const { return p0 + v0 * t + 0.5 * a * t * t; }
+  Eigen::Quaterniond q(double t) const {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(omega_body.norm() * t, omega_body.normalized()));
+  }
+  ImuSample imu(int i) const {
+    const double t = i * kDt;
+    ImuSample sample;
+    sample.utime = i * kDtUs;
+    sample.angular_velocity_rps = omega_body;
+    sample.linear_acceleration_mps2 =
+        q(std::max(0.0, t - 0.5 * kDt)).inverse() * (a - Eigen::Vector3d(0, 0, kGravity_mps2));
+    return sample;
+  }
+};
+
+// A VO whose distances are 3 % long (scale 1.03), its relative poses between
+// frames 0.1 s apart worked out from the path: the filter, told nothing of the
+// scale (log scale 0 +- 0.1), learns exp(log scale) = 1.03 to 0.1 %, and the
+// pose stays on the path.
+TEST(ErrorStateFilter, RelativePosesTeachTheVoScale) {
+  const TurningPath path;
+  NavState start;
+  start.p_ned_m = path.p(0.0);
+  start.v_ned_mps = path.v0;
+  Covariance P = Covariance::Identity() * 1e-8;
+  P(idx::kLogScale, idx::kLogScale) = 0.01;
+  P.block<3, 3>(idx::kP, idx::kP) = Eigen::Matrix3d::Identity() * 0.01;
+  ErrorStateFilter filter(ProcessNoise{}, start, P);
+  Eigen::Matrix<double, 6, 6> vo_covariance = Eigen::Matrix<double, 6, 6>::Identity();
+  vo_covariance.topLeftCorner<3, 3>() *= 0.01 * 0.01;  // 1 cm
+  vo_covariance.bottomRightCorner<3, 3>() *= 1e-4 * 1e-4;
+  double clone_t = 0.0;
+  for (int i = 0; i <= 200 * 20; ++i) {
+    filter.propagate(path.imu(i));
+    if (i % 20 != 0) continue;
+    const double t = i * kDt;
+    if (i > 0) {
+      const Eigen::Vector3d dp = 1.03 * (path.q(clone_t).inverse() * (path.p(t) - path.p(clone_t)));
+      const Eigen::Quaterniond dq = path.q(clone_t).inverse() * path.q(t);
+      ASSERT_TRUE(filter.updateRelativePose(dp, dq, vo_covariance).accepted) << t << " s";
+    }
+    filter.cloneCurrentPose();
+    clone_t = t;
+  }
+  EXPECT_NEAR(std::exp(filter.state().vo_log_scale), 1.03, 0.001);
+  EXPECT_LT((filter.state().p_ned_m - path.p(20.0)).norm(), 0.05);
+  EXPECT_LT(filter.state().q_world_body.angularDistance(path.q(20.0)), 1e-4);
+}
+
 // The barometer alone cannot tell the height from its own bias: after one
 // reading the height moves by the share of the innovation its variance holds,
 // worked out by hand for one scalar update (gain = P_h / (P_h + P_b + r^2)).
