@@ -171,19 +171,9 @@ UpdateResult ErrorStateFilter::update(const Eigen::Matrix<double, M, 1>& residua
 }
 
 void ErrorStateFilter::inject(const Eigen::Matrix<double, kStates, 1>& dx) {
-  state_.p_ned_m += dx.segment<3>(idx::kP);
-  state_.v_ned_mps += dx.segment<3>(idx::kV);
+  state_ = applyError(state_, dx);
   const Eigen::Vector3d dtheta = dx.segment<3>(idx::kTheta);
-  state_.q_world_body = (state_.q_world_body * expQuaternion(dtheta)).normalized();
-  state_.gyro_bias_rps += dx.segment<3>(idx::kGyroBias);
-  state_.accel_bias_mps2 += dx.segment<3>(idx::kAccelBias);
-  state_.baro_bias_m += dx(idx::kBaroBias);
-  state_.ground_down_m += dx(idx::kGround);
-  state_.clone_p_ned_m += dx.segment<3>(idx::kCloneP);
   const Eigen::Vector3d dtheta_clone = dx.segment<3>(idx::kCloneTheta);
-  state_.clone_q_world_body =
-      (state_.clone_q_world_body * expQuaternion(dtheta_clone)).normalized();
-  state_.vo_log_scale += dx(idx::kLogScale);
   // The covariance of the error about the new nominal state (Sola 2017, 7.2).
   Covariance G = Covariance::Identity();
   G.block<3, 3>(idx::kTheta, idx::kTheta) -= skew(0.5 * dtheta);
@@ -257,30 +247,53 @@ void ErrorStateFilter::cloneCurrentPose() {
   P_ = 0.5 * (P_ + P_.transpose());
 }
 
+NavState applyError(const NavState& state, const Eigen::Matrix<double, kStates, 1>& dx) {
+  NavState out = state;
+  out.p_ned_m += dx.segment<3>(idx::kP);
+  out.v_ned_mps += dx.segment<3>(idx::kV);
+  out.q_world_body = (state.q_world_body * expQuaternion(dx.segment<3>(idx::kTheta))).normalized();
+  out.gyro_bias_rps += dx.segment<3>(idx::kGyroBias);
+  out.accel_bias_mps2 += dx.segment<3>(idx::kAccelBias);
+  out.baro_bias_m += dx(idx::kBaroBias);
+  out.ground_down_m += dx(idx::kGround);
+  out.clone_p_ned_m += dx.segment<3>(idx::kCloneP);
+  out.clone_q_world_body =
+      (state.clone_q_world_body * expQuaternion(dx.segment<3>(idx::kCloneTheta))).normalized();
+  out.vo_log_scale += dx(idx::kLogScale);
+  return out;
+}
+
+RelativePosePrediction predictRelativePose(const NavState& state) {
+  const Eigen::Matrix3d R_clone = state.clone_q_world_body.toRotationMatrix();
+  const Eigen::Matrix3d R = state.q_world_body.toRotationMatrix();
+  const double scale = std::exp(state.vo_log_scale);
+  const Eigen::Vector3d d_clone = R_clone.transpose() * (state.p_ned_m - state.clone_p_ned_m);
+  const Eigen::Matrix3d dR = R_clone.transpose() * R;
+  RelativePosePrediction out;
+  out.dp_clone_body = scale * d_clone;
+  out.dq_clone_body = Eigen::Quaterniond(dR).normalized();
+  out.H.block<3, 3>(0, idx::kP) = scale * R_clone.transpose();
+  out.H.block<3, 3>(0, idx::kCloneP) = -scale * R_clone.transpose();
+  // R_clone_true^T = Exp(-dtheta_c) R_clone^T: the clone's angle turns d_clone.
+  out.H.block<3, 3>(0, idx::kCloneTheta) = scale * skew(d_clone);
+  out.H.block<3, 1>(0, idx::kLogScale) = scale * d_clone;
+  // dR_true = dR Exp(dtheta - dR^T dtheta_c), to first order.
+  out.H.block<3, 3>(3, idx::kTheta).setIdentity();
+  out.H.block<3, 3>(3, idx::kCloneTheta) = -dR.transpose();
+  return out;
+}
+
 UpdateResult ErrorStateFilter::updateRelativePose(const Eigen::Vector3d& dp_clone_body,
                                                   const Eigen::Quaterniond& dq_clone_body,
                                                   const Eigen::Matrix<double, 6, 6>& covariance) {
-  const Eigen::Matrix3d R_clone = state_.clone_q_world_body.toRotationMatrix();
-  const Eigen::Matrix3d R = state_.q_world_body.toRotationMatrix();
-  const double scale = std::exp(state_.vo_log_scale);
-  const Eigen::Vector3d d_clone = R_clone.transpose() * (state_.p_ned_m - state_.clone_p_ned_m);
-  const Eigen::Matrix3d dR_predicted = R_clone.transpose() * R;
+  const RelativePosePrediction predicted = predictRelativePose(state_);
   Eigen::Matrix<double, 6, 1> residual;
-  residual.head<3>() = dp_clone_body - scale * d_clone;
+  residual.head<3>() = dp_clone_body - predicted.dp_clone_body;
   // The rotation's residual as a small angle in the present body frame.
-  const Eigen::AngleAxisd rotation_residual(Eigen::Quaterniond(dR_predicted).conjugate() *
+  const Eigen::AngleAxisd rotation_residual(predicted.dq_clone_body.conjugate() *
                                             dq_clone_body.normalized());
   residual.tail<3>() = rotation_residual.angle() * rotation_residual.axis();
-  Eigen::Matrix<double, 6, kStates> H = Eigen::Matrix<double, 6, kStates>::Zero();
-  H.block<3, 3>(0, idx::kP) = scale * R_clone.transpose();
-  H.block<3, 3>(0, idx::kCloneP) = -scale * R_clone.transpose();
-  // R_clone_true^T = Exp(-dtheta_c) R_clone^T: the clone's angle turns d_clone.
-  H.block<3, 3>(0, idx::kCloneTheta) = scale * skew(d_clone);
-  H.block<3, 1>(0, idx::kLogScale) = scale * d_clone;
-  // dR_true = dR_predicted Exp(dtheta - dR_predicted^T dtheta_c), to first order.
-  H.block<3, 3>(3, idx::kTheta).setIdentity();
-  H.block<3, 3>(3, idx::kCloneTheta) = -dR_predicted.transpose();
-  return update<6>(residual, H, covariance);
+  return update<6>(residual, predicted.H, covariance);
 }
 
 UpdateResult ErrorStateFilter::updateHeading(const Eigen::Vector3d& field_body_ut,

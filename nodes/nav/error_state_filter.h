@@ -153,6 +153,20 @@ class ErrorStateFilter {
   double gate_probability_ = 0.9999;
 };
 
+// The nominal state moved by an error (as an update injects it): additive
+// for vectors, q Exp(dtheta) for attitudes.
+NavState applyError(const NavState& state, const Eigen::Matrix<double, kStates, 1>& dx);
+
+// The relative pose a VO would measure in this state (translation in the VO's
+// scale, then the rotation) and its Jacobian with respect to the error state
+// (rows: translation, then the rotation's small angle).
+struct RelativePosePrediction {
+  Eigen::Vector3d dp_clone_body = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond dq_clone_body = Eigen::Quaterniond::Identity();
+  Eigen::Matrix<double, 6, kStates> H = Eigen::Matrix<double, 6, kStates>::Zero();
+};
+RelativePosePrediction predictRelativePose(const NavState& state);
+
 // The chi-square quantile of probability p with k degrees of freedom.
 double chiSquareQuantile(double p, int k);
 
