@@ -96,6 +96,17 @@ void ErrorStateFilter::setGateProbability(double probability) {
   gate_probability_ = probability;
 }
 
+void propagateNominal(NavState& state, const ImuSample& imu, double dt) {
+  const Eigen::Vector3d omega = imu.angular_velocity_rps - state.gyro_bias_rps;
+  const Eigen::Vector3d f_body = imu.linear_acceleration_mps2 - state.accel_bias_mps2;
+  const Eigen::Quaterniond q_mid = state.q_world_body * expQuaternion(0.5 * dt * omega);
+  const Eigen::Vector3d a_world = q_mid * f_body + Eigen::Vector3d(0.0, 0.0, kGravity_mps2);
+  state.p_ned_m += state.v_ned_mps * dt + 0.5 * a_world * dt * dt;
+  state.v_ned_mps += a_world * dt;
+  state.q_world_body = (state.q_world_body * expQuaternion(omega * dt)).normalized();
+  state.utime = imu.utime;
+}
+
 void ErrorStateFilter::propagate(const ImuSample& imu) {
   if (!has_time_) {
     has_time_ = true;
@@ -115,14 +126,8 @@ void ErrorStateFilter::propagate(const ImuSample& imu) {
   const Eigen::Vector3d omega = imu.angular_velocity_rps - state_.gyro_bias_rps;
   const Eigen::Vector3d f_body = imu.linear_acceleration_mps2 - state_.accel_bias_mps2;
   const Eigen::Matrix3d R = state_.q_world_body.toRotationMatrix();
-  const Eigen::Quaterniond q_mid = state_.q_world_body * expQuaternion(0.5 * dt * omega);
-  const Eigen::Vector3d g(0.0, 0.0, kGravity_mps2);
-  const Eigen::Vector3d a_world = q_mid * f_body + g;
   const double horizontal_speed = state_.v_ned_mps.head<2>().norm();
-
-  state_.p_ned_m += state_.v_ned_mps * dt + 0.5 * a_world * dt * dt;
-  state_.v_ned_mps += a_world * dt;
-  state_.q_world_body = (state_.q_world_body * expQuaternion(omega * dt)).normalized();
+  propagateNominal(state_, imu, dt);
 
   // The error state's transition over dt (Sola 2017, eq. 269, local angle).
   Covariance F = Covariance::Identity();

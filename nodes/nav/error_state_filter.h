@@ -136,6 +136,8 @@ class ErrorStateFilter {
   void setGateProbability(double probability);
 
   const NavState& state() const { return state_; }
+  // Whether an IMU sample has set the filter's time.
+  bool hasTime() const { return has_time_; }
   const Covariance& covariance() const { return P_; }
 
  private:
@@ -152,6 +154,10 @@ class ErrorStateFilter {
   ImuSample last_imu_;
   double gate_probability_ = 0.9999;
 };
+
+// The nominal state carried over dt with one IMU sample's readings (its time
+// becomes the sample's): the filter's propagation without the covariance.
+void propagateNominal(NavState& state, const ImuSample& imu, double dt);
 
 // The nominal state moved by an error (as an update injects it): additive
 // for vectors, q Exp(dtheta) for attitudes.
