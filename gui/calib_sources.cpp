@@ -21,14 +21,6 @@
 namespace nadir::gui {
 namespace {
 
-// image_t pixels (grey, or RGB) as grey.
-cv::Mat toGray(const cv::Mat& pixels) {
-  if (pixels.channels() == 1) return pixels;
-  cv::Mat gray;
-  cv::cvtColor(pixels, gray, pixels.channels() == 4 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGB2GRAY);
-  return gray;
-}
-
 class LiveSource final : public FrameSource {
  public:
   explicit LiveSource(const LiveSourceParams& params) : channel_(params.channel) {
@@ -61,7 +53,7 @@ class LiveSource final : public FrameSource {
     if (received_ == given_ || newest_.empty()) return std::nullopt;
     given_ = received_;
     const int number = static_cast<int>(received_ - 1);
-    return SourceFrame{toGray(newest_), channel_ + " #" + std::to_string(number), number};
+    return SourceFrame{calib::toGray(newest_), channel_ + " #" + std::to_string(number), number};
   }
   bool ended() const override { return false; }
   int count() const override { return -1; }

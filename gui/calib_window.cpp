@@ -54,36 +54,6 @@ const char* const kKeptColour = "#2e7d32";
 const char* const kRefusedColour = "#e65100";
 const char* const kNoBoardColour = "#c62828";
 
-// A QLabel that shows its image scaled to its size, keeping the aspect ratio.
-class ImageLabel : public QLabel {
- public:
-  ImageLabel(const QString& placeholder, QWidget* parent) : QLabel(placeholder, parent) {
-    setAlignment(Qt::AlignCenter);
-    setMinimumSize(320, 240);
-    setWordWrap(true);
-    setStyleSheet(QStringLiteral("background-color: #202020; color: #c0c0c0;"));
-    setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Ignored);
-  }
-  void setImage(const QImage& image) {
-    image_ = image;
-    rescale();
-  }
-
- protected:
-  void resizeEvent(QResizeEvent* event) override {
-    QLabel::resizeEvent(event);
-    rescale();
-  }
-
- private:
-  void rescale() {
-    if (image_.isNull()) return;
-    setPixmap(
-        QPixmap::fromImage(image_.scaled(size(), Qt::KeepAspectRatio, Qt::SmoothTransformation)));
-  }
-  QImage image_;
-};
-
 QString fixed(double value, int decimals) { return QString::number(value, 'f', decimals); }
 
 QString boardText(const calib::BoardSpec& board) {
@@ -192,7 +162,8 @@ void CalibWindow::buildUi() {
   auto* image_panel = new QWidget(top);
   auto* image_layout = new QVBoxLayout(image_panel);
   image_layout->setContentsMargins(0, 0, 0, 0);
-  image_view_ = new ImageLabel(QStringLiteral("waiting for the first image"), image_panel);
+  image_view_ = new ImageLabel(image_panel, QStringLiteral("waiting for the first image"));
+  image_view_->setWordWrap(true);
   caption_ = new QLabel(image_panel);
   caption_->setWordWrap(true);
   caption_->setTextFormat(Qt::PlainText);
@@ -203,7 +174,8 @@ void CalibWindow::buildUi() {
   auto* undistorted_layout = new QVBoxLayout(undistorted_panel);
   undistorted_layout->setContentsMargins(0, 0, 0, 0);
   undistorted_view_ = new ImageLabel(
-      QStringLiteral("the image undistorted, once calibrated (Calibrate)"), undistorted_panel);
+      undistorted_panel, QStringLiteral("the image undistorted, once calibrated (Calibrate)"));
+  undistorted_view_->setWordWrap(true);
   undistorted_layout->addWidget(undistorted_view_, 1);
   undistorted_layout->addWidget(
       new QLabel(QStringLiteral("undistorted with the calibration"), undistorted_panel));
@@ -384,10 +356,10 @@ void CalibWindow::showStep(const StepResult& result) {
     shown_size_ = result.image_size;
     shown_kept_ = result.offer.kept;
     shown_image_ = calibQImage(result.shown);
-    static_cast<ImageLabel*>(image_view_)->setImage(shown_image_);
+    image_view_->setImage(shown_image_);
     if (!result.undistorted.empty()) {
       undistorted_image_ = calibQImage(result.undistorted);
-      static_cast<ImageLabel*>(undistorted_view_)->setImage(undistorted_image_);
+      undistorted_view_->setImage(undistorted_image_);
     }
     QString where = QString::fromStdString(result.name);
     if (source_count_ > 0) {
@@ -527,10 +499,10 @@ bool CalibWindow::calibrateNow() {
       const std::vector<calib::View>& views = engine.session.views();
       result->report = calib::formatReport(calibration, engine.session.board(), views);
       if (const std::optional<render::CameraIntrinsics> lens = engine.source->trueLens()) {
-        result->report += "\n" + calib::formatComparison(calibration, *lens);
+        result->report.append("\n").append(calib::formatComparison(calibration, *lens));
       }
-      result->report +=
-          "\n" + calib::formatCoverage(engine.session.coverage(), engine.session.tally());
+      result->report.append("\n").append(
+          calib::formatCoverage(engine.session.coverage(), engine.session.tally()));
       for (const calib::View& view : views) result->view_names.push_back(view.name);
       engine.undistorter.emplace(calibration);
       if (!engine.last_gray.empty()) {
@@ -570,7 +542,7 @@ void CalibWindow::showCalibration(const CalibrateResult& result) {
   drawRmsChart(*calibration_);
   if (!result.undistorted.empty()) {
     undistorted_image_ = calibQImage(result.undistorted);
-    static_cast<ImageLabel*>(undistorted_view_)->setImage(undistorted_image_);
+    undistorted_view_->setImage(undistorted_image_);
   }
   // Views named in the chart's note of outliers.
   if (!calibration_->rejected.empty()) {

@@ -30,6 +30,7 @@
 #include "calib/coverage.h"
 #include "calib/session.h"
 #include "gui/calib_sources.h"
+#include "gui/image_label.h"
 
 class QCheckBox;
 class QChartView;
@@ -168,8 +169,8 @@ class CalibWindow : public QMainWindow {
   };
   std::optional<AutoRun> auto_run_;
 
-  QWidget* image_view_ = nullptr;
-  QWidget* undistorted_view_ = nullptr;
+  ImageLabel* image_view_ = nullptr;
+  ImageLabel* undistorted_view_ = nullptr;
   QLabel* caption_ = nullptr;
   QLabel* source_label_ = nullptr;
   std::array<QProgressBar*, 4> coverage_bars_{};

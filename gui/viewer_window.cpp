@@ -48,38 +48,6 @@ QString swatch(const QColor& color, const QString& text) {
   return QStringLiteral("<span style=\"color:%1\">&#9632;</span> %2").arg(color.name(), text);
 }
 
-// A QLabel that shows its image scaled to its size, keeping the aspect ratio.
-class ImageLabel : public QLabel {
- public:
-  explicit ImageLabel(QWidget* parent) : QLabel(parent) {
-    setAlignment(Qt::AlignCenter);
-    setMinimumSize(320, 240);
-    setStyleSheet(QStringLiteral("background-color: #202020; color: #c0c0c0;"));
-    setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Ignored);
-  }
-  void setImage(const QImage& image) {
-    image_ = image;
-    rescale();
-  }
-
- protected:
-  void resizeEvent(QResizeEvent* event) override {
-    QLabel::resizeEvent(event);
-    rescale();
-  }
-
- private:
-  void rescale() {
-    if (image_.isNull()) {
-      setPixmap(QPixmap());
-      return;
-    }
-    setPixmap(
-        QPixmap::fromImage(image_.scaled(size(), Qt::KeepAspectRatio, Qt::SmoothTransformation)));
-  }
-  QImage image_;
-};
-
 std::string runName(const RunData& run) { return fs::path(run.dir).filename().string(); }
 
 bool isLogPath(const std::string& path) { return fs::path(path).extension() == ".lcmlog"; }
@@ -617,7 +585,7 @@ void ViewerWindow::showCamera() {
     }
   }
   camera_image_ = frame ? toQImage(*frame) : QImage();
-  static_cast<ImageLabel*>(camera_view_)->setImage(camera_image_);
+  camera_view_->setImage(camera_image_);
   if (camera_image_.isNull()) camera_view_->setText(QStringLiteral("no image"));
   camera_caption_->setText(caption);
 }

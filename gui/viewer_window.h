@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "gui/camera_frames.h"
+#include "gui/image_label.h"
 #include "gui/run_data.h"
 #include "gui/trajectory_view.h"
 #include "lcmtypes/messages.h"
@@ -123,7 +124,7 @@ class ViewerWindow : public QMainWindow {
   TrajectoryView* view_ = nullptr;
   QLabel* legend_ = nullptr;
   QComboBox* camera_run_ = nullptr;
-  QLabel* camera_view_ = nullptr;
+  ImageLabel* camera_view_ = nullptr;
   QLabel* camera_caption_ = nullptr;
   QPushButton* play_ = nullptr;
   QSlider* slider_ = nullptr;

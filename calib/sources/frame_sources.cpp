@@ -19,14 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// image_t pixels (grey, or RGB) as grey.
-cv::Mat toGray(const cv::Mat& pixels) {
-  if (pixels.channels() == 1) return pixels;
-  cv::Mat gray;
-  cv::cvtColor(pixels, gray, pixels.channels() == 4 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGB2GRAY);
-  return gray;
-}
-
 class FolderSource final : public FrameSource {
  public:
   explicit FolderSource(const std::string& folder) : folder_(folder), files_(imageFiles(folder)) {}
@@ -153,6 +145,13 @@ std::unique_ptr<FrameSource> openLogSource(const std::string& log_path,
 std::unique_ptr<FrameSource> openVirtualSource(const std::string& scenario,
                                                const std::vector<std::string>& overrides) {
   return std::make_unique<VirtualSource>(scenario, overrides);
+}
+
+cv::Mat toGray(const cv::Mat& pixels) {
+  if (pixels.channels() == 1) return pixels;
+  cv::Mat gray;
+  cv::cvtColor(pixels, gray, pixels.channels() == 4 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGB2GRAY);
+  return gray;
 }
 
 }  // namespace nadir::calib

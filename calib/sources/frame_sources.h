@@ -66,4 +66,7 @@ std::unique_ptr<FrameSource> openLogSource(const std::string& log_path, const st
 std::unique_ptr<FrameSource> openVirtualSource(const std::string& scenario,
                                                const std::vector<std::string>& overrides);
 
+// image_t's and the renderer's pixels (grey, RGB or RGBA) as grey.
+cv::Mat toGray(const cv::Mat& pixels);
+
 }  // namespace nadir::calib

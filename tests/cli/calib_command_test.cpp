@@ -18,6 +18,7 @@
 #include "calib/image_folder.h"
 #include "core/lcm_log.h"
 #include "lcmtypes/codec.h"
+#include "tests/support/run_command.h"
 
 namespace nadir {
 namespace {
@@ -27,13 +28,7 @@ namespace fs = std::filesystem;
 const std::string kPhotos = std::string(NADIR_TEST_DATA_DIR) + "/calib/opencv_left";
 
 std::pair<int, std::string> run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, ""};
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  return nadir::test::runCommand(command);
 }
 
 fs::path freshFolder(const std::string& name) {

@@ -20,6 +20,7 @@
 #include "core/bus.h"
 #include "core/lcm_log.h"
 #include "lcmtypes/bus_io.h"
+#include "tests/support/run_command.h"
 
 namespace nadir::cli {
 namespace {
@@ -42,15 +43,8 @@ std::string errorOf(const VoResetOptions& options) {
   return {};
 }
 
-// Runs a shell command; returns its exit status and its output (stdout and stderr).
 std::pair<int, std::string> run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, ""};
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  return nadir::test::runCommand(command);
 }
 
 // The VO nodes of the registry answer to their names, and the direct VO to its;

@@ -22,20 +22,14 @@
 #include "core/bus.h"
 #include "core/lcm_log.h"
 #include "nadir/pose_t.hpp"
+#include "tests/support/run_command.h"
 
 extern char** environ;
 
 namespace {
 
-// Runs a shell command; returns its exit status and its output (stdout and stderr).
 std::pair<int, std::string> run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, ""};
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  return nadir::test::runCommand(command);
 }
 
 // Event counts per channel and the POSE_TRUTH messages of an LCM log.
