@@ -375,6 +375,11 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
       t.push_back(estimate.t_s - run.t0_s);
     chart.addLine(sourceLabel(run, source), sourceColor(run, source), 1.5, t, t,
                   series.position_error_m);
+    if (!series.sigma3_m.empty()) {
+      const std::vector<double> sigma_t = sinceStart(series.sigma3_t_s, run.t0_s);
+      chart.addLine(sourceLabel(run, source) + " 3\u03c3", sourceColor(run, source).lighter(160),
+                    1.0, sigma_t, sigma_t, series.sigma3_m);
+    }
   }
   std::unique_ptr<QChart> built = chart.take();
   // An error axis starts at zero: the error's size, not its wiggle, is the point.

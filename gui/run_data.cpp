@@ -168,7 +168,7 @@ void setMetrics(RunData& run, const core::Trajectory& truth) {
     if (name != run.truth_name) others.emplace(name, estimates);
   }
   try {
-    run.metrics = eval::evaluate(truth, others, read.options);
+    run.metrics = eval::evaluate(truth, others, read.options, read.filters);
   } catch (const eval::EvalError& e) {
     throw RunDataError(run.poses_from + ": cannot evaluate against " + run.truth_name + ": " +
                        e.what());
@@ -197,7 +197,14 @@ RunData buildRun(const std::string& dir, std::shared_ptr<const RunTrajectories> 
   run.truth = truth;
   for (const auto& [name, estimates] : read->by_name) {
     if (name == truth_name) continue;
-    run.sources[name] = sourceSeries(truth, estimates, read->options.truth_max_gap_s);
+    SourceSeries& series = run.sources[name];
+    series = sourceSeries(truth, estimates, read->options.truth_max_gap_s);
+    if (const auto filter = read->filters.find(name); filter != read->filters.end()) {
+      for (const logs::FilterState& state : filter->second) {
+        series.sigma3_t_s.push_back(state.t_s);
+        series.sigma3_m.push_back(3.0 * std::sqrt(state.position_covariance_m2.trace()));
+      }
+    }
   }
   run.trajectories = std::move(read);
   if (compute_metrics) setMetrics(run, truth);
@@ -208,6 +215,7 @@ std::shared_ptr<RunTrajectories> trajectoriesOf(const logs::LogTrajectories& rec
                                                 const eval::EvalOptions& options) {
   auto read = std::make_shared<RunTrajectories>();
   read->by_name = recorded.sources;
+  read->filters = recorded.filters;
   read->by_name[kRecordedTruthName] = trackingEstimates(recorded.truth);
   read->recorded_truth = kRecordedTruthName;
   read->options = options;

@@ -44,6 +44,11 @@ struct SourceSeries {
   std::vector<double> truth_yaw_rad;
   // The TRACKING stretches (a stretch ends at any other status), as drawn in 3D.
   std::vector<core::Trajectory> tracked;
+  // A navigation filter's own bound on that error, from its states
+  // (nav_state_t): 3 sqrt(trace of the position covariance) at their stamps
+  // (absolute, s), m. Empty for a VO node.
+  std::vector<double> sigma3_t_s;
+  std::vector<double> sigma3_m;
   std::size_t size() const { return estimates.size(); }
 };
 
@@ -66,6 +71,8 @@ struct RunTrajectories {
   // By name: the recorded truth and each estimate source, in stamp order, with
   // the estimates' statuses (a truth and a TUM file's poses are all TRACKING).
   std::map<std::string, std::vector<logs::SourceEstimate>> by_name;
+  // A navigation filter's states with their covariance, by source name (logs only).
+  std::map<std::string, std::vector<logs::FilterState>> filters;
   // The one that is the truth unless another is chosen: kRecordedTruthName when
   // the run recorded one, else a guess (see recorded_truth_note).
   std::string recorded_truth;

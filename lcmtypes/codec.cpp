@@ -22,6 +22,7 @@
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
 #include "nadir/magnetometer_t.hpp"
+#include "nadir/nav_state_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/ppa_odometry_t.hpp"
 #include "nadir/range_t.hpp"
@@ -75,6 +76,11 @@ void put3(const Eigen::Vector3d& v, double out[3]) {
 
 Eigen::Vector3d get3(const double in[3]) { return {in[0], in[1], in[2]}; }
 
+void put9(const Eigen::Matrix3d& m, double out[9]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[3 * r + c] = m(r, c);
+}
+
 // Names the message in errors: "pose_t at utime 123".
 template <class Lcm>
 std::string where(const Lcm& message) {
@@ -107,6 +113,23 @@ Eigen::Quaterniond rotationFromWire(const double wxyz[4], const std::string& fie
     throw InvalidMessage(where + ": " + field + ": " + error.what() + " (norm " +
                          std::to_string(norm) + ", must be within 1e-3 of 1)");
   }
+}
+
+// A 3 x 3 covariance, row-major: finite, symmetric and with a non-negative diagonal.
+Eigen::Matrix3d covarianceFromWire(const double in[9], const std::string& field,
+                                   const std::string& where) {
+  requireFinite(in, 9, field, where);
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = in[3 * r + c];
+  for (int i = 0; i < 3; ++i) {
+    if (m(i, i) < 0.0)
+      throw InvalidMessage(where + ": " + field + " has a negative variance (" +
+                           std::to_string(m(i, i)) + " at " + std::to_string(i) + ")");
+  }
+  if ((m - m.transpose()).cwiseAbs().maxCoeff() > 1e-9 * std::max(1.0, m.cwiseAbs().maxCoeff()))
+    throw InvalidMessage(where + ": " + field + " is not symmetric");
+  return m;
 }
 
 // An enum from its wire value, refusing values the type does not define.
@@ -267,6 +290,10 @@ struct LcmOf<Image> {
 template <>
 struct LcmOf<VoEstimate> {
   using type = nadir::vo_estimate_t;
+};
+template <>
+struct LcmOf<NavState> {
+  using type = nadir::nav_state_t;
 };
 template <>
 struct LcmOf<PpaOdometry> {
@@ -476,6 +503,29 @@ Bytes encode(const VoEstimate& message) {
   out.num_features = message.num_features;
   out.num_resets = message.num_resets;
   out.processing_time_s = message.processing_time_s;
+  return toBytes(out);
+}
+
+Bytes encode(const NavState& message) {
+  nadir::nav_state_t out{};
+  out.utime = message.utime;
+  out.source = message.source;
+  out.pose.utime = message.utime;
+  put3(message.p_ned_m, out.pose.pos);
+  put3(message.v_ned_mps, out.pose.vel);
+  core::quaternionToWire(message.q_world_body, out.pose.orientation);
+  put9(message.position_covariance_m2, out.position_covariance_m2);
+  put9(message.velocity_covariance_m2ps2, out.velocity_covariance_m2ps2);
+  put9(message.attitude_covariance_rad2, out.attitude_covariance_rad2);
+  put3(message.gyro_bias_rps, out.gyro_bias_rps);
+  put3(message.accel_bias_mps2, out.accel_bias_mps2);
+  out.baro_bias_m = message.baro_bias_m;
+  out.ground_down_m = message.ground_down_m;
+  out.vo_scale = message.vo_scale;
+  out.last_gps_utime = message.last_gps_utime;
+  out.updates_fused = message.updates_fused;
+  out.updates_refused = message.updates_refused;
+  out.updates_late = message.updates_late;
   return toBytes(out);
 }
 
@@ -719,6 +769,38 @@ VoEstimate decode<VoEstimate>(const void* data, std::size_t size) {
 }
 
 template <>
+NavState decode<NavState>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::nav_state_t>(data, size);
+  const std::string at = where(in);
+  NavState out;
+  out.utime = in.utime;
+  out.source = in.source;
+  requireFinite(in.pose.pos, 3, "pose.pos", at);
+  requireFinite(in.pose.vel, 3, "pose.vel", at);
+  out.p_ned_m = get3(in.pose.pos);
+  out.v_ned_mps = get3(in.pose.vel);
+  out.q_world_body = rotationFromWire(in.pose.orientation, "pose.orientation", at);
+  out.position_covariance_m2 =
+      covarianceFromWire(in.position_covariance_m2, "position_covariance_m2", at);
+  out.velocity_covariance_m2ps2 =
+      covarianceFromWire(in.velocity_covariance_m2ps2, "velocity_covariance_m2ps2", at);
+  out.attitude_covariance_rad2 =
+      covarianceFromWire(in.attitude_covariance_rad2, "attitude_covariance_rad2", at);
+  requireFinite(in.gyro_bias_rps, 3, "gyro_bias_rps", at);
+  requireFinite(in.accel_bias_mps2, 3, "accel_bias_mps2", at);
+  out.gyro_bias_rps = get3(in.gyro_bias_rps);
+  out.accel_bias_mps2 = get3(in.accel_bias_mps2);
+  out.baro_bias_m = in.baro_bias_m;
+  out.ground_down_m = in.ground_down_m;
+  out.vo_scale = in.vo_scale;
+  out.last_gps_utime = in.last_gps_utime;
+  out.updates_fused = in.updates_fused;
+  out.updates_refused = in.updates_refused;
+  out.updates_late = in.updates_late;
+  return out;
+}
+
+template <>
 PpaOdometry decode<PpaOdometry>(const void* data, std::size_t size) {
   const auto in = fromBytes<nadir::ppa_odometry_t>(data, size);
   PpaOdometry out;
@@ -805,6 +887,7 @@ NADIR_MSG_TYPE(BodyRates)
 NADIR_MSG_TYPE(CameraInfo)
 NADIR_MSG_TYPE(Image)
 NADIR_MSG_TYPE(VoEstimate)
+NADIR_MSG_TYPE(NavState)
 NADIR_MSG_TYPE(PpaOdometry)
 NADIR_MSG_TYPE(TargetDetection)
 NADIR_MSG_TYPE(VoCommand)
@@ -816,7 +899,7 @@ std::string typeName(const void* data, std::size_t size) {
       knownTypes<nadir::pose_t, nadir::imu_t, nadir::range_t, nadir::gps_t, nadir::baro_t,
                  nadir::magnetometer_t, nadir::geodetic_position_t, nadir::attitude_t,
                  nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t,
-                 nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t,
+                 nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t, nadir::nav_state_t,
                  nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
                  nadir::heartbeat_t>();
   const std::int64_t hash = fingerprintOf(data, size);

@@ -46,6 +46,7 @@ Bytes encode(const CameraInfo& message);
 // Raw GRAY or RGB pixels, or MJPEG when message.jpeg_quality > 0.
 Bytes encode(const Image& message);
 Bytes encode(const VoEstimate& message);
+Bytes encode(const NavState& message);
 Bytes encode(const PpaOdometry& message);
 Bytes encode(const TargetDetection& message);
 Bytes encode(const VoCommand& message);

@@ -157,6 +157,28 @@ struct VoEstimate {
   double processing_time_s = 0.0;
 };
 
+// nav_state_t: the navigation filter's fused state and its uncertainty.
+struct NavState {
+  std::int64_t utime = 0;
+  std::string source;
+  Eigen::Vector3d p_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_ned_mps = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d position_covariance_m2 = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d velocity_covariance_m2ps2 = Eigen::Matrix3d::Zero();
+  // Small rotation in the body frame: R_true = R_estimate Exp(dtheta).
+  Eigen::Matrix3d attitude_covariance_rad2 = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d gyro_bias_rps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  double baro_bias_m = 0.0;
+  double ground_down_m = 0.0;
+  double vo_scale = 1.0;
+  std::int64_t last_gps_utime = -1;  // -1: no fix fused yet
+  int updates_fused = 0;
+  int updates_refused = 0;
+  int updates_late = 0;
+};
+
 // ppa_odometry_t: the SCAMP-5 chip's image alignment for one frame.
 struct PpaOdometry {
   std::int64_t utime = 0;

@@ -40,6 +40,23 @@ bool TrajectoryCollector::add(const std::string& channel, const void* data, std:
     }
     return true;
   }
+  if (msg::isType<msg::NavState>(data, size)) {
+    try {
+      const msg::NavState state = msg::decode<msg::NavState>(data, size);
+      FilterState sample;
+      sample.t_s = core::stampFromUtime(state.utime);
+      sample.p_ned_m = state.p_ned_m;
+      sample.q_world_body = state.q_world_body;
+      sample.position_covariance_m2 = state.position_covariance_m2;
+      sample.attitude_covariance_rad2 = state.attitude_covariance_rad2;
+      if (state.last_gps_utime >= 0)
+        sample.last_gps_t_s = core::stampFromUtime(state.last_gps_utime);
+      filters_[state.source.empty() ? channel : state.source].push_back(sample);
+    } catch (const std::exception&) {
+      ++undecodable_[channel];
+    }
+    return true;
+  }
   if (!msg::isType<msg::VoEstimate>(data, size)) return false;
   try {
     const msg::VoEstimate estimate = msg::decode<msg::VoEstimate>(data, size);
@@ -86,6 +103,11 @@ LogTrajectories TrajectoryCollector::trajectories() const {
   out.truth.erase(duplicate, out.truth.end());
   for (auto& [name, estimates] : out.sources) {
     std::stable_sort(estimates.begin(), estimates.end(),
+                     [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  }
+  out.filters = filters_;
+  for (auto& [name, states] : out.filters) {
+    std::stable_sort(states.begin(), states.end(),
                      [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   }
   return out;

@@ -3,10 +3,12 @@
 // (pose_t) and every VO source's estimates (vo_estimate_t), stamped with the
 // messages' utime. Estimates are found by their type on whatever channel they
 // come, and named by their `source` field (the node's registry name), so a
-// renamed channel is never missed. The truth is pose_t on the channel given,
+// renamed channel is never missed; so are a navigation filter's states
+// (nav_state_t). The truth is pose_t on the channel given,
 // or, when none is given, on the one channel of the log that carries pose_t.
 
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -32,10 +34,24 @@ struct SourceEstimate : core::StampedPose {
   int resets = 0;  // the node's num_resets so far
 };
 
+// One fused state of a navigation filter (nav_state_t) with the uncertainty
+// the evaluation checks it against.
+struct FilterState {
+  double t_s = 0.0;
+  Eigen::Vector3d p_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d position_covariance_m2 = Eigen::Matrix3d::Zero();
+  // Body-frame small angle: R_true = R_estimate Exp(dtheta).
+  Eigen::Matrix3d attitude_covariance_rad2 = Eigen::Matrix3d::Zero();
+  // The last GPS fix the filter fused, s; NaN before the first.
+  double last_gps_t_s = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct LogTrajectories {
   core::Trajectory truth;  // sorted by stamp, one pose per stamp
   std::string truth_channel;
   std::map<std::string, std::vector<SourceEstimate>> sources;  // by source name, sorted
+  std::map<std::string, std::vector<FilterState>> filters;     // by source name, sorted
   std::string damage;  // the reader's damage report and what was left out; empty if clean
 };
 
@@ -45,8 +61,8 @@ class TrajectoryCollector {
  public:
   // truth_channel: where the truth's pose_t is; empty: the channel carrying pose_t.
   explicit TrajectoryCollector(std::string truth_channel = {});
-  // Takes one message; false if it is neither truth nor an estimate. A message of
-  // either type that does not decode, or holds a non-finite position or a
+  // Takes one message; false if it is neither truth, an estimate nor a filter
+  // state. A message of these types that does not decode, or holds a non-finite position or a
   // quaternion that is not a rotation, is counted and left out.
   bool add(const std::string& channel, const void* data, std::size_t size);
   std::size_t truthPoses() const;
@@ -58,6 +74,7 @@ class TrajectoryCollector {
   std::string truth_channel_;
   std::map<std::string, core::Trajectory> poses_;  // pose_t by channel
   std::map<std::string, std::vector<SourceEstimate>> sources_;
+  std::map<std::string, std::vector<FilterState>> filters_;
   std::map<std::string, std::size_t> undecodable_;  // channel -> count
 };
 

@@ -10,6 +10,7 @@ std::unique_ptr<Entry> cameraEntry();
 std::unique_ptr<Entry> ppaEntry();
 std::unique_ptr<Entry> voFeatureEntry();
 std::unique_ptr<Entry> voDirectEntry();
+std::unique_ptr<Entry> navEntry();
 std::unique_ptr<Entry> simEntry();
 
 bool Node::turn(core::Bus& bus) {
@@ -24,6 +25,7 @@ const std::vector<std::unique_ptr<Entry>>& registry() {
     list.push_back(ppaEntry());
     list.push_back(voFeatureEntry());
     list.push_back(voDirectEntry());
+    list.push_back(navEntry());
     list.push_back(simEntry());
     return list;
   }();

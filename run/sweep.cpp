@@ -247,9 +247,21 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
   std::string csv;
   for (const SweepAxis& axis : spec.axes) csv += axis.key + ",";
   csv += "run,truth_track_length_m";
+  // A filter's own figures, for the sources that are filters in some cell.
+  std::set<std::string> filters;
+  for (const SweepCell& cell : cells) {
+    if (!cell.metrics) continue;
+    for (const auto& [name, metrics] : cell.metrics->sources)
+      if (metrics.filter) filters.insert(name);
+  }
   for (const std::string& source : sources) {
     csv += "," + source + ".position_rmse_m," + source + ".rotation_rmse_deg," + source +
            ".tracked_pct," + source + ".resets";
+    if (filters.contains(source)) {
+      for (const char* column : {".error_denial_60_m", ".error_denial_120_m", ".error_end_m",
+                                 ".nees_position_mean", ".nees_attitude_mean"})
+        csv += "," + source + column;
+    }
   }
   csv += "\n";
   for (const SweepCell& cell : cells) {
@@ -264,6 +276,15 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
       } else {
         csv += "," + number(metrics->position_rmse_m) + "," + number(metrics->rotation_rmse_deg) +
                "," + number(metrics->tracked_pct) + "," + resetsText(*metrics);
+      }
+      if (!filters.contains(source)) continue;
+      if (metrics == nullptr || !metrics->filter) {
+        csv += ",,,,,";
+      } else {
+        const eval::FilterMetrics& f = *metrics->filter;
+        for (double value : {f.error_denial_60_m, f.error_denial_120_m, f.error_end_m,
+                             f.nees_position_mean, f.nees_attitude_mean})
+          csv += "," + number(value);
       }
     }
     csv += "\n";

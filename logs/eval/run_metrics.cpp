@@ -91,6 +91,20 @@ Json sourceJson(const SourceMetrics& m) {
                   {"translation_m", statisticsJson(m.rpe_translation_m)},
                   {"rotation_deg", statisticsJson(m.rpe_rotation_deg)}};
   j["note"] = m.note;
+  if (m.filter) {
+    const FilterMetrics& f = *m.filter;
+    j["filter"] = Json{{"states_evaluated", f.states_evaluated},
+                       {"had_gps", f.had_gps},
+                       {"denial_s", number(f.denial_s)},
+                       {"error_denial_60_m", number(f.error_denial_60_m)},
+                       {"error_denial_120_m", number(f.error_denial_120_m)},
+                       {"error_end_m", number(f.error_end_m)},
+                       {"nees_position_mean", number(f.nees_position_mean)},
+                       {"nees_attitude_mean", number(f.nees_attitude_mean)},
+                       {"nees_position_in_band_pct", number(f.nees_position_in_band_pct)},
+                       {"nees_attitude_in_band_pct", number(f.nees_attitude_in_band_pct)},
+                       {"nees_band", Json::array({kNees3Low, kNees3High})}};
+  }
   return j;
 }
 
@@ -187,6 +201,21 @@ SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::stri
   m.rpe_translation_m = r.statistics(rpe, "translation_m", where + ".rpe");
   m.rpe_rotation_deg = r.statistics(rpe, "rotation_deg", where + ".rpe");
   m.note = r.text(j, "note", where);
+  if (const auto it = j.find("filter"); it != j.end() && !it->is_null()) {
+    const std::string here = where + ".filter";
+    FilterMetrics f;
+    f.states_evaluated = r.count(*it, "states_evaluated", here);
+    f.had_gps = r.flag(*it, "had_gps", here);
+    f.denial_s = r.number(*it, "denial_s", here);
+    f.error_denial_60_m = r.number(*it, "error_denial_60_m", here);
+    f.error_denial_120_m = r.number(*it, "error_denial_120_m", here);
+    f.error_end_m = r.number(*it, "error_end_m", here);
+    f.nees_position_mean = r.number(*it, "nees_position_mean", here);
+    f.nees_attitude_mean = r.number(*it, "nees_attitude_mean", here);
+    f.nees_position_in_band_pct = r.number(*it, "nees_position_in_band_pct", here);
+    f.nees_attitude_in_band_pct = r.number(*it, "nees_attitude_in_band_pct", here);
+    m.filter = f;
+  }
   return m;
 }
 
@@ -326,13 +355,19 @@ SourceMetrics evaluateSource(const core::Trajectory& truth,
 
 RunMetrics evaluate(const core::Trajectory& truth,
                     const std::map<std::string, std::vector<SourceEstimate>>& sources,
-                    const EvalOptions& options) {
+                    const EvalOptions& options,
+                    const std::map<std::string, std::vector<logs::FilterState>>& filters) {
   RunMetrics run;
   run.truth_poses = truth.size();
   run.truth_track_length_m = core::trackLength(truth);
   run.truth_duration_s = truth.empty() ? 0.0 : truth.back().t_s - truth.front().t_s;
   for (const auto& [name, estimates] : sources) {
     run.sources[name] = evaluateSource(truth, estimates, options);
+  }
+  for (const auto& [name, states] : filters) {
+    const auto source = run.sources.find(name);
+    if (source == run.sources.end() || states.empty()) continue;
+    source->second.filter = evaluateFilter(truth, states, options.truth_max_gap_s);
   }
   if (sources.empty()) validateOptions(options);
   return run;
@@ -342,7 +377,7 @@ RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out
                              const EvalOptions& options, const std::string& truth_channel) {
   RunEvaluation run;
   run.recorded = logs::readRunLog(log_path, truth_channel);
-  run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options);
+  run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options, run.recorded.filters);
   const std::filesystem::path dir(out_dir.empty() ? std::string(".") : out_dir);
   run.metrics_path = (dir / "metrics.json").string();
   writeMetricsJson(run.metrics_path, run.metrics, options);
@@ -439,6 +474,20 @@ std::string formatResultsTable(const RunMetrics& metrics) {
                   cell(m.track_length_diff_pct, 2).c_str(), cell(m.mean_abs_error_m, 3).c_str(),
                   cell(m.end_point_m, 3).c_str(), cell(m.end_point_pct, 2).c_str(),
                   cell(m.rate_hz, 1).c_str(), m.resets ? std::to_string(*m.resets).c_str() : "-");
+    out += line;
+  }
+  for (const auto& [name, m] : metrics.sources) {
+    if (!m.filter) continue;
+    const FilterMetrics& f = *m.filter;
+    std::snprintf(line, sizeof line,
+                  "%s as a filter: %s %s s; error at denial +60 s %s m, +120 s %s m, end %s m; "
+                  "NEES position %s, attitude %s (95 %% band %.2f-%.2f; in it %s %%, %s %%)\n",
+                  name.c_str(), f.had_gps ? "GPS last fused at" : "no GPS; started at",
+                  cell(f.denial_s, 1).c_str(), cell(f.error_denial_60_m, 2).c_str(),
+                  cell(f.error_denial_120_m, 2).c_str(), cell(f.error_end_m, 2).c_str(),
+                  cell(f.nees_position_mean, 2).c_str(), cell(f.nees_attitude_mean, 2).c_str(),
+                  kNees3Low, kNees3High, cell(f.nees_position_in_band_pct, 1).c_str(),
+                  cell(f.nees_attitude_in_band_pct, 1).c_str());
     out += line;
   }
   if (metrics.sources.empty()) {

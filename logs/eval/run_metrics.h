@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "logs/eval/filter_metrics.h"
 #include "logs/eval/metrics.h"
 #include "logs/eval/trajectory.h"
 #include "logs/run_log.h"
@@ -48,6 +49,8 @@ struct SourceMetrics {
   Statistics rpe_translation_m;
   Statistics rpe_rotation_deg;
   std::string note;  // why something is missing; empty if nothing is
+  // A navigation filter's own figures (its nav_state_t); none for a VO node.
+  std::optional<FilterMetrics> filter;
 };
 
 struct RunMetrics {
@@ -62,9 +65,12 @@ struct RunMetrics {
 SourceMetrics evaluateSource(const core::Trajectory& truth,
                              const std::vector<SourceEstimate>& estimates,
                              const EvalOptions& options);
+// A filter's states (filters, by source name) add its FilterMetrics to the
+// source of the same name.
 RunMetrics evaluate(const core::Trajectory& truth,
                     const std::map<std::string, std::vector<SourceEstimate>>& sources,
-                    const EvalOptions& options);
+                    const EvalOptions& options,
+                    const std::map<std::string, std::vector<logs::FilterState>>& filters = {});
 
 // A run's log evaluated, with what was written for it.
 struct RunEvaluation {

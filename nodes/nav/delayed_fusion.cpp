@@ -1,6 +1,8 @@
 #include "nodes/nav/delayed_fusion.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
@@ -35,13 +37,25 @@ bool DelayedFusion::addMeasurement(std::int64_t utime, Update update) {
 
 void DelayedFusion::release() {
   while (!queue_.empty() && queue_.begin()->first <= horizon_utime_) {
-    Event& event = queue_.begin()->second;
+    const auto it = queue_.begin();
+    Event& event = it->second;
     if (event.is_imu) {
       filter_.propagate(event.imu);
     } else {
+      if (filter_.hasTime() && it->first > filter_.state().utime) {
+        // At its own time: the interval to the next sample is split there,
+        // with that sample's readings over both parts.
+        const auto next = std::find_if(std::next(it), queue_.end(),
+                                       [](const auto& entry) { return entry.second.is_imu; });
+        if (next != queue_.end()) {
+          ImuSample split = next->second.imu;
+          split.utime = it->first;
+          filter_.propagate(split);
+        }
+      }
       event.update(filter_);
     }
-    queue_.erase(queue_.begin());
+    queue_.erase(it);
   }
 }
 

@@ -28,7 +28,9 @@ class DelayedFusion {
   void addImu(const ImuSample& imu);
   // A measurement stamped utime. One older than the horizon is refused
   // (counted by late()); measurements of equal stamps are fused in the order
-  // they came. A measurement is fused at the last IMU sample at or before it.
+  // they came. A measurement is fused at its own time: the interval between
+  // the IMU samples around it is split there (the later sample's readings
+  // over both parts); with no later sample yet, at the last one before it.
   bool addMeasurement(std::int64_t utime, Update update);
 
   // The delayed filter, and the present estimate carried forward from it.

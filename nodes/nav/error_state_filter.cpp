@@ -147,6 +147,7 @@ void ErrorStateFilter::propagate(const ImuSample& imu) {
   q(idx::kBaroBias) = square(noise_.baro_bias_random_walk_m_rts) * dt;
   q(idx::kGround) = square(noise_.ground_random_walk_m_rtm) * horizontal_speed * dt;
   q(idx::kLogScale) = square(noise_.vo_log_scale_random_walk_rts) * dt;
+  q.segment<3>(idx::kMagBias).setConstant(square(noise_.mag_bias_random_walk_ut_rts) * dt);
   P_ = F * P_ * F.transpose();
   P_.diagonal() += q;
   P_ = 0.5 * (P_ + P_.transpose());
@@ -233,10 +234,17 @@ UpdateResult ErrorStateFilter::updateRange(double range_m, const Eigen::Vector3d
     H(0, idx::kGround) = 1.0 / c;
   }
   // d_world moves with the attitude error: R Exp(dtheta) d = d_world - R [d]x dtheta.
+  // The attitude is considered, not corrected: its uncertainty widens the
+  // range's, but the range does not turn it. Off vertical, the ground the
+  // beam meets is not the ground under the vehicle, and the flat ground's
+  // error would be read as a tilt (at 300 m and 45 deg of bank, 3 m of relief
+  // is 0.4 deg).
   const Eigen::RowVector3d dc_dtheta = -(R * skew(d_body)).row(2);
-  H.block<1, 3>(0, idx::kTheta) = -height / (c * c) * dc_dtheta;
+  const Eigen::RowVector3d dr_dtheta = -height / (c * c) * dc_dtheta;
+  const double attitude_variance =
+      dr_dtheta * P_.block<3, 3>(idx::kTheta, idx::kTheta) * dr_dtheta.transpose();
   return update<1>(Eigen::Matrix<double, 1, 1>(range_m - height / c), H,
-                   Eigen::Matrix<double, 1, 1>(sigma_m * sigma_m));
+                   Eigen::Matrix<double, 1, 1>(sigma_m * sigma_m + attitude_variance));
 }
 
 void ErrorStateFilter::cloneCurrentPose() {
@@ -265,6 +273,7 @@ NavState applyError(const NavState& state, const Eigen::Matrix<double, kStates, 
   out.clone_q_world_body =
       (state.clone_q_world_body * expQuaternion(dx.segment<3>(idx::kCloneTheta))).normalized();
   out.vo_log_scale += dx(idx::kLogScale);
+  out.mag_bias_ut += dx.segment<3>(idx::kMagBias);
   return out;
 }
 
@@ -307,7 +316,7 @@ UpdateResult ErrorStateFilter::updateHeading(const Eigen::Vector3d& field_body_u
   UpdateResult refused;
   refused.dimension = 1;
   const Eigen::Matrix3d R = state_.q_world_body.toRotationMatrix();
-  const Eigen::Vector3d measured_world = R * field_body_ut;
+  const Eigen::Vector3d measured_world = R * (field_body_ut - state_.mag_bias_ut);
   if (measured_world.head<2>().norm() < 0.1 * measured_world.norm() ||
       field_world_ut.head<2>().norm() < 0.1 * field_world_ut.norm())
     return refused;
@@ -319,6 +328,14 @@ UpdateResult ErrorStateFilter::updateHeading(const Eigen::Vector3d& field_body_u
   Eigen::Matrix<double, 1, kStates> H = Eigen::Matrix<double, 1, kStates>::Zero();
   // A body-frame angle error turns the heading by its world z component.
   H.block<1, 3>(0, idx::kTheta) = R.row(2);
+  // An offset error db moves the field seen in the world by -R db. The
+  // heading's derivative is taken at the field expected, not the one measured:
+  // at the measured one it would follow the noise, and the noise's share of it
+  // would drive the offset steadily along the field (8 uT in 20 s at rest).
+  const double expected_horizontal2 = field_world_ut.head<2>().squaredNorm();
+  const Eigen::RowVector3d d_seen_d_world(-field_world_ut.y() / expected_horizontal2,
+                                          field_world_ut.x() / expected_horizontal2, 0.0);
+  H.block<1, 3>(0, idx::kMagBias) = -d_seen_d_world * R;
   return update<1>(Eigen::Matrix<double, 1, 1>(residual), H,
                    Eigen::Matrix<double, 1, 1>(sigma_rad * sigma_rad));
 }

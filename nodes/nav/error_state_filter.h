@@ -19,9 +19,9 @@ inline constexpr double kGravity_mps2 = 9.80665;
 
 // The error state: position, velocity, attitude (local, body frame), gyro and
 // accelerometer biases, barometer bias, ground height (down coordinate), a
-// clone of the pose at the last VO frame (stochastic cloning), and the VO's
-// log scale.
-inline constexpr int kStates = 24;
+// clone of the pose at the last VO frame (stochastic cloning), the VO's log
+// scale, and the magnetometer's hard-iron offset (body frame).
+inline constexpr int kStates = 27;
 namespace idx {
 inline constexpr int kP = 0;
 inline constexpr int kV = 3;
@@ -33,6 +33,7 @@ inline constexpr int kGround = 16;
 inline constexpr int kCloneP = 17;
 inline constexpr int kCloneTheta = 20;
 inline constexpr int kLogScale = 23;
+inline constexpr int kMagBias = 24;
 }  // namespace idx
 
 using Covariance = Eigen::Matrix<double, kStates, kStates>;
@@ -53,6 +54,9 @@ struct NavState {
   Eigen::Quaterniond clone_q_world_body = Eigen::Quaterniond::Identity();
   // The VO's distances are exp(vo_log_scale) times the true ones.
   double vo_log_scale = 0.0;
+  // What the magnetometer reads besides the Earth's field: the airframe's own
+  // (hard iron), body frame, uT.
+  Eigen::Vector3d mag_bias_ut = Eigen::Vector3d::Zero();
 };
 
 // Process noise, in the IMU's datasheet units (as sim::ImuParams).
@@ -67,6 +71,8 @@ struct ProcessNoise {
   double ground_random_walk_m_rtm = 0.1;
   // How the VO's scale wanders, per sqrt(s) of log scale.
   double vo_log_scale_random_walk_rts = 1e-3;
+  // How the airframe's own field wanders, uT per sqrt(s).
+  double mag_bias_random_walk_ut_rts = 1e-3;
 };
 
 struct ImuSample {
@@ -106,15 +112,18 @@ class ErrorStateFilter {
   UpdateResult updatePosition(const Eigen::Vector3d& p_ned_m, const Eigen::Matrix3d& covariance);
   UpdateResult updateVelocity(const Eigen::Vector3d& v_ned_mps, const Eigen::Matrix3d& covariance);
   // A rangefinder's distance along direction_body to flat ground: the ground
-  // state, or ground_down (the map) when given, under the estimate.
+  // state, or ground_down (the map) when given, under the estimate. The
+  // attitude's uncertainty widens the range's; the range does not correct it.
   UpdateResult updateRange(double range_m, const Eigen::Vector3d& direction_body, double sigma_m,
                            const GroundDown& ground_down = {});
 
-  // The heading a magnetometer gives: the measured field turned into the
-  // world by the estimated attitude, against the Earth's field there
-  // (field_world_ut, NED), compared in the horizontal plane only, so that a
-  // hard-iron offset or a disturbed field cannot tilt the estimate.
-  // sigma_rad is the heading's 1-sigma. Refused when either horizontal
+  // The heading a magnetometer gives: the measured field less the estimated
+  // hard-iron offset, turned into the world by the estimated attitude,
+  // against the Earth's field there (field_world_ut, NED), compared in the
+  // horizontal plane only, so that a disturbed field cannot tilt the
+  // estimate. The offset is learnt as the heading is known otherwise (GPS, the
+  // VO's motion) while the attitude changes. sigma_rad is the heading's 1-sigma
+  // from the sensor's white noise. Refused when either horizontal
   // component is under a tenth of its vector (near the magnetic poles).
   UpdateResult updateHeading(const Eigen::Vector3d& field_body_ut,
                              const Eigen::Vector3d& field_world_ut, double sigma_rad);

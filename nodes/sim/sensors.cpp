@@ -205,6 +205,9 @@ void GpsParams::visit(core::ParamVisitor& v) {
           {.doc = "outage windows in sim time, s: [start_s, end_s, start_s, end_s, ...]",
            .min = 0,
            .max = 1e9});
+  v.field(
+      "denied_after_s", &denied_after_s,
+      {.doc = "no fix from this sim time on, s (-1: never): GPS denial", .min = -1, .max = 1e9});
   // Checked on every walk (validation included): the list's shape, which a
   // field spec cannot express.
   if (outages_s.size() % 2 != 0) {
@@ -224,6 +227,7 @@ GpsModel::GpsModel(const GpsParams& params)
 
 bool GpsModel::inOutage(std::int64_t utime) const {
   const double t_s = static_cast<double>(utime) * 1e-6;
+  if (params_.denied_after_s >= 0.0 && t_s >= params_.denied_after_s) return true;
   for (std::size_t i = 0; i + 1 < params_.outages_s.size(); i += 2) {
     if (t_s >= params_.outages_s[i] && t_s < params_.outages_s[i + 1]) return true;
   }

@@ -132,6 +132,8 @@ struct GpsParams {
   int num_satellites = 12;
   // Outage windows in sim time, s: flat [start_s, end_s, start_s, end_s, ...].
   std::vector<double> outages_s = {};
+  // GPS denial: no fix from this sim time on, s; -1: never.
+  double denied_after_s = -1.0;
 
   // Throws core::ParamError (from the walk) if outages_s has an odd length or
   // a window ends before it starts.
@@ -146,7 +148,8 @@ using GpsSample = msg::Gps;
 // Position (white noise in metres, north/east with horizontal_sigma_m, down
 // with vertical_sigma_m, converted exactly with the LocalNedFrame) and NED
 // velocity with white noise. Inside an outage window (start_s <= t < end_s,
-// t = utime / 1e6) the fix is NONE and the other fields are zero.
+// t = utime / 1e6) and from denied_after_s on, the fix is NONE and the other
+// fields are zero.
 class GpsModel {
  public:
   // Throws core::ParamError if a parameter is invalid.

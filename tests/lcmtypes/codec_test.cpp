@@ -23,6 +23,7 @@
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
 #include "nadir/magnetometer_t.hpp"
+#include "nadir/nav_state_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/range_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
@@ -377,6 +378,54 @@ TEST(Codec, VoEstimateRoundTrip) {
   unset.status = nadir::vo_estimate_t::STATUS_INITIALIZING;
   EXPECT_EQ(decode<VoEstimate>(bytesOf(unset)).q_world_body.coeffs(),
             Eigen::Quaterniond::Identity().coeffs());
+}
+
+// nav_state_t: the filter's state and its covariances survive the wire, row by
+// row; a covariance that is not symmetric, has a negative variance or is not
+// finite is refused naming the field.
+TEST(Codec, NavStateRoundTripAndRefusals) {
+  NavState state;
+  state.utime = 2'000'000;
+  state.source = "nav";
+  state.p_ned_m = Eigen::Vector3d(10, -20, -300);
+  state.v_ned_mps = Eigen::Vector3d(25, 1, -0.5);
+  state.q_world_body = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  state.position_covariance_m2 << 4, 0.5, 0, 0.5, 9, 0.1, 0, 0.1, 1;
+  state.velocity_covariance_m2ps2 = Eigen::Matrix3d::Identity() * 0.01;
+  state.attitude_covariance_rad2 = Eigen::Vector3d(1e-6, 2e-6, 3e-6).asDiagonal();
+  state.gyro_bias_rps = Eigen::Vector3d(1e-3, -2e-3, 3e-4);
+  state.vo_scale = 1.02;
+  state.last_gps_utime = 1'500'000;
+  state.updates_fused = 7;
+  state.updates_refused = 2;
+  state.updates_late = 1;
+  const nadir::nav_state_t wire = asLcm<nadir::nav_state_t>(encode(state));
+  EXPECT_EQ(wire.position_covariance_m2[1], 0.5);  // row-major: (0, 1)
+  EXPECT_EQ(wire.position_covariance_m2[5], 0.1);  // (1, 2)
+  EXPECT_EQ(wire.pose.vel[0], 25.0);
+  const NavState back = decode<NavState>(encode(state));
+  EXPECT_EQ(back.source, "nav");
+  EXPECT_EQ(back.p_ned_m, state.p_ned_m);
+  EXPECT_EQ(back.v_ned_mps, state.v_ned_mps);
+  EXPECT_EQ(back.position_covariance_m2, state.position_covariance_m2);
+  EXPECT_EQ(back.attitude_covariance_rad2, state.attitude_covariance_rad2);
+  EXPECT_EQ(back.gyro_bias_rps, state.gyro_bias_rps);
+  EXPECT_EQ(back.vo_scale, 1.02);
+  EXPECT_EQ(back.last_gps_utime, 1'500'000);
+  EXPECT_EQ(back.updates_refused, 2);
+
+  nadir::nav_state_t bad = wire;
+  bad.position_covariance_m2[1] = 0.7;
+  EXPECT_NE(invalidReason<NavState>(bad).find("position_covariance_m2 is not symmetric"),
+            std::string::npos);
+  bad = wire;
+  bad.attitude_covariance_rad2[4] = -1e-6;
+  EXPECT_NE(invalidReason<NavState>(bad).find("attitude_covariance_rad2 has a negative variance"),
+            std::string::npos);
+  bad = wire;
+  bad.velocity_covariance_m2ps2[0] = std::nan("");
+  EXPECT_NE(invalidReason<NavState>(bad).find("velocity_covariance_m2ps2[0] is not finite"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------- types

@@ -13,6 +13,7 @@
 #include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
 #include "logs/run_log.h"
+#include "nadir/nav_state_t.hpp"
 #include "nadir/pose_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
 
@@ -83,6 +84,56 @@ std::string writeSampleLog(const std::string& name) {
     }
   }
   return path;
+}
+
+// A navigation filter's nav_state_t is gathered by its source name with its
+// covariances and the last GPS fix, and its metrics get the filter's figures;
+// one with an asymmetric covariance is left out and counted as damage.
+TEST(RunLog, FilterStatesAreGatheredAndEvaluated) {
+  const std::string path = tempPath("filter");
+  {
+    core::LcmLogWriter writer(path);
+    for (int k = 0; k <= 200; ++k) {
+      const std::int64_t utime = kStart + k * 10'000;
+      writeMessage(
+          writer, utime, "POSE_TRUTH",
+          truthMessage(utime, Eigen::Vector3d(0.2 * k, 1, -50), Eigen::Quaterniond::Identity()));
+      if (k % 10 != 0) continue;
+      writeMessage(
+          writer, utime, "POSE_NAV",
+          estimateMessage(utime, "nav", SourceEstimate::kTracking, Eigen::Vector3d(0.2 * k, 1, -50),
+                          Eigen::Quaterniond::Identity()));
+      nadir::nav_state_t state{};
+      state.utime = utime;
+      state.source = "nav";
+      state.pose = truthMessage(utime, Eigen::Vector3d(0.2 * k + 0.1, 1, -50),
+                                Eigen::Quaterniond::Identity());
+      for (int i : {0, 4, 8}) {
+        state.position_covariance_m2[i] = 0.01;
+        state.velocity_covariance_m2ps2[i] = 0.01;
+        state.attitude_covariance_rad2[i] = 1e-4;
+      }
+      state.vo_scale = 1.0;
+      state.last_gps_utime = kStart;
+      if (k == 100) state.position_covariance_m2[1] = 0.5;  // not symmetric
+      writeMessage(writer, utime, "POSE_NAV_STATE", state);
+    }
+  }
+  const LogTrajectories run = readRunLog(path);
+  ASSERT_EQ(run.filters.count("nav"), 1u);
+  const std::vector<FilterState>& states = run.filters.at("nav");
+  ASSERT_EQ(states.size(), 20u);
+  EXPECT_NEAR(states.front().last_gps_t_s, core::stampFromUtime(kStart), 1e-6);
+  EXPECT_EQ(states.front().position_covariance_m2(1, 1), 0.01);
+  EXPECT_NE(run.damage.find("1 undecodable or invalid message on POSE_NAV_STATE"),
+            std::string::npos)
+      << run.damage;
+  const eval::RunMetrics metrics =
+      eval::evaluate(run.truth, run.sources, eval::EvalOptions{}, run.filters);
+  ASSERT_TRUE(metrics.sources.at("nav").filter.has_value());
+  // 0.1 m north against a variance of 0.01 m^2: NEES 1 at every state.
+  EXPECT_NEAR(metrics.sources.at("nav").filter->nees_position_mean, 1.0, 1e-9);
+  EXPECT_NEAR(metrics.sources.at("nav").filter->denial_s, 0.0, 1e-9);
 }
 
 // readRunLog takes truth and estimates with their utimes, names sources by their

@@ -204,16 +204,19 @@ TEST(Run, FeatureVoTracksTheDemoFlight) {
   EXPECT_LT(std::abs(vo.track_length_diff_pct), 3.0);
 }
 
-// The direct VO on 20 s of the demo flight, twice: it tracks every
-// frame, stays metric from the rangefinder, and its estimates on
-// POSE_VO_DIRECT are byte-identical between the runs.
+// The direct VO on 20 s of the demo flight, twice, with the navigation filter
+// on it (GPS denied after 10 s): it tracks every frame, stays metric from the
+// rangefinder, and its estimates on POSE_VO_DIRECT and the filter's on
+// POSE_NAV and POSE_NAV_STATE are byte-identical between the runs.
 TEST(Run, DirectVoTracksTheDemoFlightTheSameTwice) {
   std::vector<std::string> poses[2];
+  std::vector<std::string> nav[2];
   for (int k = 0; k < 2; ++k) {
     RunOptions options;
     options.scenario = "default";
     options.out_dir = tempDir("vo_direct_" + std::to_string(k));
-    options.overrides = {"duration_s=20", "vo_feature.enabled=false"};
+    options.overrides = {"duration_s=20", "vo_feature.enabled=false", "nav.enabled=true",
+                         "nav.vo_channel=POSE_VO_DIRECT", "sensors.gps.denied_after_s=10"};
     options.record_images = false;
     const RunResult result = runScenario(options);
     ASSERT_EQ(result.metrics.sources.count("vo_direct"), 1u);
@@ -225,13 +228,25 @@ TEST(Run, DirectVoTracksTheDemoFlightTheSameTwice) {
       EXPECT_LT(vo.rotation_rmse_deg, 0.5);
       EXPECT_LT(std::abs(vo.track_length_diff_pct), 2.0);
     }
+    if (k == 0) {
+      ASSERT_EQ(result.metrics.sources.count("nav"), 1u);
+      const eval::SourceMetrics& filter = result.metrics.sources.at("nav");
+      ASSERT_TRUE(filter.filter.has_value());
+      EXPECT_NEAR(filter.filter->denial_s, 10.0, 0.25);  // the last 5 Hz fix before 10 s
+      EXPECT_LT(filter.position_rmse_m, 2.0);
+    }
     core::LcmLogReader reader(result.log_path);
-    while (auto event = reader.next())
+    while (auto event = reader.next()) {
       if (event->channel == "POSE_VO_DIRECT")
         poses[k].emplace_back(event->data.begin(), event->data.end());
+      if (event->channel == "POSE_NAV" || event->channel == "POSE_NAV_STATE")
+        nav[k].emplace_back(event->data.begin(), event->data.end());
+    }
   }
   EXPECT_GT(poses[0].size(), 350u);  // 20 frames/s for 20 s
   EXPECT_TRUE(poses[0] == poses[1]) << "the estimates differ between the runs";
+  EXPECT_GT(nav[0].size(), 1900u);  // 50 Hz for 20 s, on two channels
+  EXPECT_TRUE(nav[0] == nav[1]) << "the filter's output differs between the runs";
 }
 
 // A sweep file's grid: every combination, last axis fastest, named by its values.
@@ -450,7 +465,8 @@ TEST(Launch, ADeadNodeIsReported) {
   LaunchOptions options;
   options.scenario = "default";
   options.out_dir = (fs::path(dir) / "out").string();
-  options.overrides = {"duration_s=30", "vo_feature.enabled=false", "vo_direct.enabled=false"};
+  options.overrides = {"duration_s=30", "vo_feature.enabled=false", "vo_direct.enabled=false",
+                       "nav.enabled=false"};
   options.bin_dir = bin.string();
   std::atomic<bool> stop{false};
   std::ostringstream out;

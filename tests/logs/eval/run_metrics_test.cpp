@@ -288,6 +288,47 @@ TEST(EvalMetricsJson, RoundTrip) {
   const std::string table = formatResultsTable(read);
   EXPECT_NE(table.find("vo_direct"), std::string::npos);
   EXPECT_NE(table.find("vo_feature"), std::string::npos);
+  EXPECT_EQ(table.find("as a filter"), std::string::npos);
+  EXPECT_FALSE(read.sources.at("vo_feature").filter.has_value());
+}
+
+// A filter's block goes out and comes back, null where a figure does not
+// exist, and the table gets its line.
+TEST(EvalMetricsJson, FilterFiguresRoundTrip) {
+  RunMetrics written;
+  written.truth_poses = 10;
+  SourceMetrics& nav = written.sources["nav"];
+  FilterMetrics filter;
+  filter.states_evaluated = 42;
+  filter.had_gps = true;
+  filter.denial_s = 50.0;
+  filter.error_denial_60_m = 2.5;
+  filter.error_end_m = 3.25;
+  filter.nees_position_mean = 3.1;
+  filter.nees_attitude_mean = 4.2;
+  filter.nees_position_in_band_pct = 95.5;
+  filter.nees_attitude_in_band_pct = 80.0;
+  nav.filter = filter;
+  const std::string path = tempPath("filter_metrics.json");
+  writeMetricsJson(path, written, EvalOptions{});
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  EXPECT_NE(text.str().find("\"error_denial_120_m\": null"), std::string::npos);
+  const RunMetrics read = readMetricsJson(path);
+  ASSERT_TRUE(read.sources.at("nav").filter.has_value());
+  const FilterMetrics& back = *read.sources.at("nav").filter;
+  EXPECT_EQ(back.states_evaluated, 42u);
+  EXPECT_TRUE(back.had_gps);
+  EXPECT_EQ(back.denial_s, 50.0);
+  EXPECT_EQ(back.error_denial_60_m, 2.5);
+  EXPECT_TRUE(std::isnan(back.error_denial_120_m));
+  EXPECT_EQ(back.error_end_m, 3.25);
+  EXPECT_EQ(back.nees_attitude_in_band_pct, 80.0);
+  const std::string table = formatResultsTable(read);
+  EXPECT_NE(table.find("nav as a filter: GPS last fused at 50.0 s; error at denial +60 s 2.50 m, "
+                       "+120 s - m, end 3.25 m; NEES position 3.10, attitude 4.20"),
+            std::string::npos)
+      << table;
 }
 
 // A damaged metrics.json is refused with the file and the key.

@@ -137,6 +137,52 @@ TEST(ErrorStateFilter, GyroBiasIsLearntAsFastAsTheCovarianceSays) {
   EXPECT_NEAR(filter.state().gyro_bias_rps.y(), true_bias.y(), 2e-4);
 }
 
+// A step in the roll gyro's bias, 1e-3 rad/s, after a minute at rest with the
+// bias learnt (GPS position and velocity at 5 Hz). The model's random walk of
+// 1e-4 rad/s/sqrt(s) makes a change of that size a 1-sigma event over
+// T = (1e-3 / 1e-4)^2 = 100 s: the filter must have followed it to a fifth by
+// then. A model without the walk would never move (its gain goes to zero).
+TEST(ErrorStateFilter, GyroBiasStepIsFollowedWithinTheTimeTheModelPredicts) {
+  const double step_rps = 1e-3;
+  ProcessNoise noise;
+  noise.gyro_bias_random_walk_rps_rts = 1e-4;
+  const double predicted_s = std::pow(step_rps / noise.gyro_bias_random_walk_rps_rts, 2);
+  NavState start;
+  Covariance P = Covariance::Zero();
+  P.block<3, 3>(idx::kP, idx::kP) = Eigen::Matrix3d::Identity() * 1.0;
+  P.block<3, 3>(idx::kV, idx::kV) = Eigen::Matrix3d::Identity() * 0.01;
+  P.block<3, 3>(idx::kTheta, idx::kTheta) = Eigen::Matrix3d::Identity() * 1e-6;
+  P.block<3, 3>(idx::kGyroBias, idx::kGyroBias) = Eigen::Matrix3d::Identity() * 1e-8;
+  P.block<3, 3>(idx::kAccelBias, idx::kAccelBias) = Eigen::Matrix3d::Identity() * 1e-4;
+  P(idx::kBaroBias, idx::kBaroBias) = 1.0;
+  P(idx::kGround, idx::kGround) = 1.0;
+  ErrorStateFilter filter(noise, start, P);
+  ImuSample imu;
+  imu.linear_acceleration_mps2 = Eigen::Vector3d(0.0, 0.0, -kGravity_mps2);
+  const Eigen::Matrix3d gps_p = Eigen::Matrix3d::Identity() * 0.25;
+  const Eigen::Matrix3d gps_v = Eigen::Matrix3d::Identity() * 0.0025;
+  const double step_s = 60.0;
+  double followed_s = -1.0;
+  const int samples = static_cast<int>(std::lround((step_s + predicted_s) * 200.0));
+  for (int i = 0; i <= samples; ++i) {
+    const double t_s = i * kDt;
+    imu.utime = i * kDtUs;
+    imu.angular_velocity_rps = Eigen::Vector3d(t_s >= step_s ? step_rps : 0.0, 0.0, 0.0);
+    filter.propagate(imu);
+    if (i % 40 != 0) continue;
+    filter.updatePosition(Eigen::Vector3d::Zero(), gps_p);
+    filter.updateVelocity(Eigen::Vector3d::Zero(), gps_v);
+    const double error = std::abs(filter.state().gyro_bias_rps.x() - imu.angular_velocity_rps.x());
+    if (t_s < step_s) {
+      ASSERT_LT(error, 0.05 * step_rps) << "before the step, at " << t_s << " s";
+    }
+    if (t_s >= step_s && followed_s < 0.0 && error < 0.2 * step_rps) followed_s = t_s - step_s;
+  }
+  ASSERT_GE(followed_s, 0.0) << "not followed within " << predicted_s << " s";
+  EXPECT_LT(followed_s, predicted_s);
+  EXPECT_NEAR(filter.state().gyro_bias_rps.x(), step_rps, 0.2 * step_rps);
+}
+
 // The path of ConstantAccelerationWhileTurning, worked out exactly at t.
 struct TurningPath {
   Eigen::Vector3d p0{0.0, 0.0, -50.0}, v0{20.0, 5.0, 0.0}, a{0.4, -0.3, 0.05};
@@ -393,6 +439,49 @@ TEST(ErrorStateFilter, HeadingFromTheMagnetometerTurnsOnlyTheYaw) {
     EXPECT_NEAR(ypr_est[1], ypr_true[1], 1e-6) << "pitch, hard iron " << hard_iron_ut;
     EXPECT_NEAR(ypr_est[2], ypr_true[2], 1e-6) << "roll, hard iron " << hard_iron_ut;
   }
+}
+
+// The airframe's own field (hard iron, body frame) learnt from the heading: a
+// level vehicle at rest turning about its vertical at 0.2 rad/s, its attitude
+// known from exact gyros, reads the Earth's field plus (1.5, -1.0, 0.8) uT.
+// After two turns the horizontal offset is known to 0.1 uT (the vertical one
+// does not turn the heading of a level vehicle: it stays at its prior), and the
+// heading error of the last reading is under 0.05 deg. A sign error in the
+// offset's Jacobian drives it away instead.
+TEST(ErrorStateFilter, MagnetometerLearnsTheHardIronWhileTurning) {
+  const double dec = -4.6 * M_PI / 180.0, inc = 66.5 * M_PI / 180.0;
+  const Eigen::Vector3d field_world =
+      52.0 *
+      Eigen::Vector3d(std::cos(inc) * std::cos(dec), std::cos(inc) * std::sin(dec), std::sin(inc));
+  const Eigen::Vector3d hard_iron(1.5, -1.0, 0.8);
+  const double yaw_rate = 0.2;
+  ProcessNoise noise;
+  noise.gyro_noise_density_rps_rthz = 1e-7;
+  noise.gyro_bias_random_walk_rps_rts = 0.0;
+  Covariance P = Covariance::Identity() * 1e-6;
+  P.block<3, 3>(idx::kTheta, idx::kTheta) = Eigen::Matrix3d::Identity() * 1e-10;
+  P.block<3, 3>(idx::kGyroBias, idx::kGyroBias) = Eigen::Matrix3d::Identity() * 1e-14;
+  P.block<3, 3>(idx::kMagBias, idx::kMagBias) = Eigen::Matrix3d::Identity() * 4.0;  // 2 uT
+  ErrorStateFilter filter(noise, NavState{}, P);
+  ImuSample imu;
+  imu.angular_velocity_rps = Eigen::Vector3d(0.0, 0.0, yaw_rate);
+  imu.linear_acceleration_mps2 = Eigen::Vector3d(0.0, 0.0, -kGravity_mps2);
+  double last_heading_error_deg = 0.0;
+  const int samples = static_cast<int>(std::lround(4.0 * M_PI / yaw_rate * 200.0));
+  for (int i = 0; i <= samples; ++i) {
+    imu.utime = i * kDtUs;
+    filter.propagate(imu);
+    if (i % 4 != 0) continue;  // the magnetometer at 50 Hz
+    const Eigen::Quaterniond truth(Eigen::AngleAxisd(yaw_rate * i * kDt, Eigen::Vector3d::UnitZ()));
+    filter.updateHeading(truth.inverse() * field_world + hard_iron, field_world,
+                         0.5 * M_PI / 180.0);
+    const Eigen::Vector3d error = 2.0 * (filter.state().q_world_body.conjugate() * truth).vec();
+    last_heading_error_deg = error.z() * 180.0 / M_PI;
+  }
+  EXPECT_NEAR(filter.state().mag_bias_ut.x(), hard_iron.x(), 0.1);
+  EXPECT_NEAR(filter.state().mag_bias_ut.y(), hard_iron.y(), 0.1);
+  EXPECT_NEAR(filter.state().mag_bias_ut.z(), 0.0, 1e-6);
+  EXPECT_LT(std::abs(last_heading_error_deg), 0.05);
 }
 
 // A reading far outside what the covariance allows is refused and changes nothing.
