@@ -25,6 +25,7 @@
 #include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/nav/nav_node.h"
+#include "nodes/nav/nav_process_params.h"
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
 
@@ -51,8 +52,12 @@ int main(int argc, char** argv) {
     overrides.insert(overrides.begin(), "nav.enabled=true");
     const nadir::nodes::ScenarioParams scenario =
         nadir::nodes::loadScenario(folder.scenario.string(), overrides);
-    const nadir::nodes::Entry& entry = nadir::nodes::entry(nadir::nav::kNavSourceName);
-    const auto params = entry.fromScenario(scenario).as<nadir::nav::NavNodeParams>();
+    // The node's group with the scenario's sensor figures and world, as nadir run gives them.
+    const auto process = nadir::nodes::entry(nadir::nav::kNavSourceName)
+                             .fromScenario(scenario)
+                             .as<nadir::nav::NavProcessParams>();
+    const nadir::nav::NavNodeParams& params = process.node;
+    const nadir::nav::GroundDown ground_down = nadir::nav::groundDownOf(process);
 
     // Every message the filter may read, in memory, so that the log's reading is not timed.
     std::vector<nadir::core::LogEvent> events;
@@ -92,7 +97,7 @@ int main(int argc, char** argv) {
                             raw.data, raw.size);
             });
       }
-      nadir::nav::NavNode node(*bus, params);
+      nadir::nav::NavNode node(*bus, params, ground_down);
       const auto start = std::chrono::steady_clock::now();
       for (const nadir::core::LogEvent& event : events) {
         bus->publish(event.channel, event.data.data(), event.data.size(), event.timestamp_utime);

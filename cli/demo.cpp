@@ -13,7 +13,8 @@ namespace nadir::cli {
 int runDemo(const std::string& out_dir) {
   std::cout << "nadir demo: the `default` scenario through the whole pipeline in one process,\n"
                "in sim time: the simulator, the downward camera rendering the procedural\n"
-               "world and every VO node built so far; recorded, evaluated and tabled.\n"
+               "world, the VO nodes and the navigation filter on the feature VO (GPS denied\n"
+               "after 20 s); recorded, evaluated and tabled.\n"
             << std::endl;
   run::RunOptions options;
   options.scenario = "default";

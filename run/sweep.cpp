@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -284,7 +285,7 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
         const eval::FilterMetrics& f = *metrics->filter;
         for (double value : {f.error_denial_60_m, f.error_denial_120_m, f.error_end_m,
                              f.nees_position_mean, f.nees_attitude_mean})
-          csv += "," + number(value);
+          csv += "," + (std::isfinite(value) ? number(value) : std::string());  // none: empty
       }
     }
     csv += "\n";

@@ -6,15 +6,19 @@
 #include <sstream>
 
 #include "nodes/nav/nav_node.h"
+#include "nodes/nav/nav_process_params.h"
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
 
 namespace nadir::nodes {
 namespace {
 
+using nav::NavProcessParams;
+
 class NavLiveNode final : public Node {
  public:
-  NavLiveNode(core::Bus& bus, const nav::NavNodeParams& params) : node_(bus, params) {}
+  NavLiveNode(core::Bus& bus, const NavProcessParams& params)
+      : node_(bus, params.node, nav::groundDownOf(params)) {}
 
   std::string summary() const override {
     const nav::NavCounts& counts = node_.counts();
@@ -37,7 +41,7 @@ class NavLiveNode final : public Node {
   nav::NavNode node_;
 };
 
-class NavEntry final : public TypedEntry<nav::NavNodeParams> {
+class NavEntry final : public TypedEntry<NavProcessParams> {
  public:
   NavEntry()
       : TypedEntry({.name = nav::kNavSourceName,
@@ -56,9 +60,12 @@ class NavEntry final : public TypedEntry<nav::NavNodeParams> {
   }
 
  protected:
-  nav::NavNodeParams paramsFrom(const ScenarioParams& scenario) const override {
-    nav::NavNodeParams params = scenario.node<nav::NavNodeParams>(info().name);
-    if (!params.match_scenario_sensors) return params;
+  NavProcessParams paramsFrom(const ScenarioParams& scenario) const override {
+    NavProcessParams process;
+    process.world = scenario.world;
+    nav::NavNodeParams& params = process.node;
+    params = scenario.node<nav::NavNodeParams>(info().name);
+    if (!params.match_scenario_sensors) return process;
     const core::Geodetic origin = scenarioOrigin(scenario);
     constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
     params.origin_lat_deg = origin.lat_rad * kRadToDeg;
@@ -84,14 +91,14 @@ class NavEntry final : public TypedEntry<nav::NavNodeParams> {
     if (horizontal_ut > 0.0)
       model.heading_sigma_deg =
           std::atan2(sensors.magnetometer.model.noise_sigma_ut, horizontal_ut) * kRadToDeg;
-    return params;
+    return process;
   }
-  std::unique_ptr<Node> build(core::Bus& bus, const nav::NavNodeParams& params) const override {
+  std::unique_ptr<Node> build(core::Bus& bus, const NavProcessParams& params) const override {
     return std::make_unique<NavLiveNode>(bus, params);
   }
-  std::vector<Stream> publishes(const nav::NavNodeParams& params) const override {
-    return {{.channel = params.pose_channel, .rate_hz = params.publish_rate_hz},
-            {.channel = params.state_channel, .rate_hz = params.publish_rate_hz}};
+  std::vector<Stream> publishes(const NavProcessParams& params) const override {
+    return {{.channel = params.node.pose_channel, .rate_hz = params.node.publish_rate_hz},
+            {.channel = params.node.state_channel, .rate_hz = params.node.publish_rate_hz}};
   }
 };
 

@@ -117,6 +117,9 @@ void NavNodeParams::visit(core::ParamVisitor& v) {
   v.field("use_gps", &use_gps, {.doc = "fuse GPS fixes (position and velocity)"});
   v.field("use_mag", &use_mag, {.doc = "fuse the magnetometer's heading"});
   v.field("use_vo", &use_vo, {.doc = "fuse the VO's relative poses"});
+  v.field(
+      "range_against_map", &range_against_map,
+      {.doc = "the rangefinder against the scenario's map of the ground, not the ground state"});
   v.field("publish_rate_hz", &publish_rate_hz,
           {.doc = "output rate in message time, Hz (0: every IMU sample)",
            .min = 0.0,
@@ -141,11 +144,14 @@ void NavNodeParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "initial", "the uncertainty around the start pose, 1 sigma", initial);
 }
 
-NavNode::NavNode(core::Bus& bus, const NavNodeParams& params)
+NavNode::NavNode(core::Bus& bus, const NavNodeParams& params, GroundDown ground_down)
     : bus_(bus),
       params_(params),
       frame_(originOf(params)),
+      ground_down_(params.range_against_map ? std::move(ground_down) : GroundDown{}),
       earth_field_ned_ut_(earthField_ned_ut(params.sensors)) {
+  if (params_.range_against_map && !ground_down_)
+    throw core::ParamError("nav.range_against_map: no map of the ground was given");
   auto on_invalid = [this](const std::string& reason) { drop(reason); };
   subscriptions_.push_back(msg::subscribe<msg::Pose>(
       bus_, params_.truth_channel,
@@ -174,11 +180,12 @@ NavNode::NavNode(core::Bus& bus, const NavNodeParams& params)
          min_down = std::cos(model.range_max_tilt_deg * kDegToRad)](const msg::Range& range) {
           if (range.status != msg::RangeStatus::VALID) return;
           measure(range.utime, &NavCounts::range,
-                  [range, sigma, min_down](ErrorStateFilter& filter) {
+                  [this, range, sigma, min_down](ErrorStateFilter& filter) {
                     const Eigen::Vector3d beam_world =
                         filter.state().q_world_body * range.direction_body.normalized();
                     if (beam_world.z() < min_down) return UpdateResult{};  // not tried
-                    return filter.updateRange(range.range_m, range.direction_body, sigma);
+                    return filter.updateRange(range.range_m, range.direction_body, sigma,
+                                              ground_down_);
                   });
         },
         on_invalid));

@@ -4,6 +4,7 @@
 #include <QChartView>
 #include <QColor>
 #include <QImage>
+#include <QLineSeries>
 #include <QValueAxis>
 #include <QWidget>
 
@@ -109,6 +110,28 @@ TEST_F(GuiPlots, HeadlessRenderingWritesNonBlankPngsOfTheRightSize) {
 
 // A source keeps its colour whatever the run's other sources, two sources of one
 // run never share one, and none is the truth's black.
+// A navigation filter's error is drawn with its 3-sigma envelope, a series of
+// its own at its states' stamps (since the truth's start); a VO's has none.
+TEST_F(GuiPlots, AFiltersErrorHasItsEnvelope) {
+  RunData run = loadRun(test::writeTumRun("envelope_run").string());
+  ASSERT_EQ(run.sources.count("vo_test"), 1u);
+  Figure plain = errorFigure(run);
+  ASSERT_EQ(plain.charts.size(), 1u);
+  EXPECT_EQ(plain.charts[0]->series().size(), 1);
+  SourceSeries& source = run.sources.at("vo_test");
+  source.sigma3_t_s = {run.t0_s + 0.5, run.t0_s + 1.0, run.t0_s + 1.5};
+  source.sigma3_m = {0.3, 0.6, 0.9};
+  Figure figure = errorFigure(run);
+  ASSERT_EQ(figure.charts[0]->series().size(), 2);
+  const auto* envelope = dynamic_cast<QLineSeries*>(figure.charts[0]->series().at(1));
+  ASSERT_NE(envelope, nullptr);
+  EXPECT_TRUE(envelope->name().endsWith(QString::fromUtf8(" 3\u03c3")))
+      << envelope->name().toStdString();
+  ASSERT_EQ(envelope->count(), 3);
+  EXPECT_DOUBLE_EQ(envelope->at(1).x(), 1.0);
+  EXPECT_DOUBLE_EQ(envelope->at(1).y(), 0.6);
+}
+
 TEST_F(GuiPlots, EachSourceKeepsItsColour) {
   RunData alone, together, crowd;
   alone.sources["vo_feature"];

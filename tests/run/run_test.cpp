@@ -403,6 +403,36 @@ TEST(Sweep, TablesFromTheCellsThatRan) {
       << sweepMarkdown(spec, cells);
 }
 
+// A filter's figures get their columns in results.csv, empty where a figure
+// does not exist (a flight that ends before the denial + 120 s); a VO's do not.
+TEST(Sweep, FilterFiguresInTheCsv) {
+  SweepSpec spec;
+  spec.scenario = "default";
+  spec.out_dir = tempDir("sweep_filter");
+  spec.axes = {{"vehicle.altitude_agl_m", {"100"}}};
+  const std::vector<SweepCell> planned = planSweep(spec);
+  eval::RunMetrics metrics;
+  metrics.truth_track_length_m = 500.0;
+  metrics.sources["vo_feature"] = sourceMetrics(true, 2.5, 0.2, 100.0);
+  metrics.sources["nav"] = sourceMetrics(true, 0.75, 0.125, 100.0);
+  eval::FilterMetrics filter;
+  filter.error_denial_60_m = 1.5;
+  filter.error_end_m = 1.25;
+  filter.nees_position_mean = 2.5;
+  filter.nees_attitude_mean = 3.25;
+  metrics.sources["nav"].filter = filter;
+  fs::create_directories(planned[0].out_dir);
+  eval::writeMetricsJson((fs::path(planned[0].out_dir) / "metrics.json").string(), metrics,
+                         eval::EvalOptions{});
+  const std::string csv = sweepCsv(spec, readSweep(spec));
+  EXPECT_NE(csv.find("nav.resets,nav.error_denial_60_m,nav.error_denial_120_m,nav.error_end_m,"
+                     "nav.nees_position_mean,nav.nees_attitude_mean,vo_feature.position_rmse_m"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",1.500,,1.250,2.500,3.250,2.500,"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find("vo_feature.nees"), std::string::npos) << csv;
+}
+
 // Live: the nodes start as processes, the scenario ends, every node stops cleanly, the
 // recording holds the truth and the camera, and the scenario and the charts lie beside
 // it. Needs UDP multicast (skipped without it).

@@ -421,7 +421,12 @@ TEST(ErrorStateFilter, HeadingFromTheMagnetometerTurnsOnlyTheYaw) {
         Eigen::Quaterniond(Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ())) *
         truth;
     Covariance P = Covariance::Identity() * 1e-6;
-    P.block<3, 3>(idx::kTheta, idx::kTheta) = Eigen::Matrix3d::Identity() * 0.1;  // 18 deg
+    // The heading unknown (18 deg about the world's vertical), the tilt known:
+    // a tilt's uncertainty would widen the heading's noise (considered, not
+    // corrected). In the body frame: R^T diag R.
+    const Eigen::Matrix3d R = start.q_world_body.toRotationMatrix();
+    P.block<3, 3>(idx::kTheta, idx::kTheta) =
+        R.transpose() * Eigen::Vector3d(1e-12, 1e-12, 0.1).asDiagonal() * R;
     ErrorStateFilter filter(ProcessNoise{}, start, P);
     const Eigen::Vector3d field_body =
         truth.inverse() * field_world + Eigen::Vector3d(0, 0, hard_iron_ut);

@@ -198,6 +198,44 @@ TEST_F(NavNodeTest, GpsDenialShowsInTheState) {
   EXPECT_GT(sigmaAt(29.0), 2.0 * sigmaAt(9.5));
 }
 
+// The rangefinder against a known map: over ground that rises 5 m per 100 m
+// north, with neither GPS nor barometer, the ranges straight down hold the
+// height to 0.1 m over the 20 s circle. Asked for without a map, the node refuses.
+TEST_F(NavNodeTest, RangeAgainstAKnownMapHoldsTheHeight) {
+  NavNodeParams params = baseParams();
+  params.use_gps = false;
+  params.use_baro = false;
+  params.use_vo = false;
+  params.use_range = true;
+  params.range_against_map = true;
+  EXPECT_THROW(NavNode(*bus_, params), core::ParamError);
+  const GroundDown ground_down = [](double north_m, double) { return -0.05 * north_m; };
+  node_ = std::make_unique<NavNode>(*bus_, params, ground_down);
+  subscriptions_.push_back(msg::subscribe<msg::NavState>(
+      *bus_, params.state_channel,
+      [this](const msg::NavState& state) { output_.states.push_back(state); }));
+  send("POSE_TRUTH", truthAt(0.0));
+  for (int k = 0; k <= 4000; ++k) {
+    const double t_s = k / 200.0;
+    send(params.imu_channel, imuAt(t_s));
+    if (k % 4 != 0) continue;
+    const msg::Pose truth = truthAt(t_s);
+    msg::Range range;
+    range.utime = truth.utime;
+    range.range_m = ground_down(truth.p_ned_m.x(), truth.p_ned_m.y()) - truth.p_ned_m.z();
+    range.status = msg::RangeStatus::VALID;
+    range.min_range_m = 0.1;
+    range.max_range_m = 1000.0;
+    send(params.range_channel, range);
+  }
+  EXPECT_GT(node_->counts().range, 900u);
+  ASSERT_FALSE(output_.states.empty());
+  for (const msg::NavState& state : output_.states) {
+    if (state.utime < 2'000'000) continue;
+    EXPECT_NEAR(state.p_ned_m.z(), -kAltitude_m, 0.1) << "at " << state.utime * 1e-6 << " s";
+  }
+}
+
 // A fix without an accuracy is dropped and counted, naming the message; what
 // was fused before stays.
 TEST_F(NavNodeTest, ABadFixIsDroppedAndNamed) {
