@@ -150,6 +150,7 @@ NavNode::NavNode(core::Bus& bus, const NavNodeParams& params, GroundDown ground_
       frame_(originOf(params)),
       ground_down_(params.range_against_map ? std::move(ground_down) : GroundDown{}),
       earth_field_ned_ut_(earthField_ned_ut(params.sensors)) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "nav");
   if (params_.range_against_map && !ground_down_)
     throw core::ParamError("nav.range_against_map: no map of the ground was given");
   auto on_invalid = [this](const std::string& reason) { drop(reason); };

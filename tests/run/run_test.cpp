@@ -127,7 +127,8 @@ TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
   EXPECT_EQ(readFile(replayed), readFile(result.log_path));
   const logs::LogTrajectories recorded = logs::readRunLog(replayed);
   const eval::EvalOptions options;
-  const eval::RunMetrics metrics = eval::evaluate(recorded.truth, recorded.sources, options);
+  const eval::RunMetrics metrics =
+      eval::evaluate(recorded.truth, recorded.sources, options, recorded.filters);
   const std::string json = (fs::path(result.out_dir) / "replayed.json").string();
   eval::writeMetricsJson(json, metrics, options);
   EXPECT_EQ(readFile(json), readFile(result.metrics_path));

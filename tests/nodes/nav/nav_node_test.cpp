@@ -254,5 +254,17 @@ TEST_F(NavNodeTest, ABadFixIsDroppedAndNamed) {
   EXPECT_EQ(node_->counts().imu, 2u);
 }
 
+// Parameters out of their range are refused, naming the key.
+TEST_F(NavNodeTest, AnImpossibleParameterIsNamed) {
+  NavNodeParams params = baseParams();
+  params.delay_s = -0.1;
+  try {
+    NavNode node(*bus_, params);
+    FAIL() << "a negative delay was taken";
+  } catch (const core::ParamError& error) {
+    EXPECT_NE(std::string(error.what()).find("delay_s"), std::string::npos) << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace nadir::nav
