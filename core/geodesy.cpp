@@ -30,6 +30,13 @@ struct LocalNedFrame::Impl {
   GeographicLib::LocalCartesian enu;
 };
 
+Eigen::Vector3d magneticField_ned(double declination_deg, double inclination_deg, double strength) {
+  constexpr double kRad = std::numbers::pi / 180.0;
+  const double d = declination_deg * kRad, i = inclination_deg * kRad;
+  return strength *
+         Eigen::Vector3d(std::cos(i) * std::cos(d), std::cos(i) * std::sin(d), std::sin(i));
+}
+
 Geodetic geodeticFromDegrees(double lat_deg, double lon_deg, double alt_m) {
   return Geodetic{lat_deg / kDegPerRad, lon_deg / kDegPerRad, alt_m};
 }

@@ -16,6 +16,11 @@ struct Geodetic {
 
 Geodetic geodeticFromDegrees(double lat_deg, double lon_deg, double alt_m);
 
+// The Earth's magnetic field in NED from its declination (east of true north)
+// and inclination (below the horizon), deg, and its strength:
+// F (cos I cos D, cos I sin D, sin I), in the strength's unit.
+Eigen::Vector3d magneticField_ned(double declination_deg, double inclination_deg, double strength);
+
 // Local north-east-down frame tangent to the ellipsoid at an origin
 // (GeographicLib::LocalCartesian, which is east-north-up, converted here once).
 // Exact: no flat-earth approximation, so it round-trips at any distance.

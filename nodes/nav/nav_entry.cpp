@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "nodes/nav/nav_node.h"
@@ -67,7 +68,7 @@ class NavEntry final : public TypedEntry<NavProcessParams> {
     params = scenario.node<nav::NavNodeParams>(info().name);
     if (!params.match_scenario_sensors) return process;
     const core::Geodetic origin = scenarioOrigin(scenario);
-    constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+    constexpr double kRadToDeg = 180.0 / std::numbers::pi;
     params.origin_lat_deg = origin.lat_rad * kRadToDeg;
     params.origin_lon_deg = origin.lon_rad * kRadToDeg;
     params.origin_alt_m = origin.alt_m;
@@ -87,7 +88,7 @@ class NavEntry final : public TypedEntry<NavProcessParams> {
     model.field_ut = sensors.magnetometer.model.field_ut;
     // The heading's white noise: the sensor's across the field's horizontal part.
     const double horizontal_ut =
-        model.field_ut * std::cos(model.inclination_deg * 3.14159265358979323846 / 180.0);
+        model.field_ut * std::cos(model.inclination_deg * std::numbers::pi / 180.0);
     if (horizontal_ut > 0.0)
       model.heading_sigma_deg =
           std::atan2(sensors.magnetometer.model.noise_sigma_ut, horizontal_ut) * kRadToDeg;

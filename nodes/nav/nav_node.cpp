@@ -11,14 +11,6 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
-Eigen::Vector3d earthField_ned_ut(const NavSensorModel& model) {
-  const double declination = model.declination_deg * kDegToRad;
-  const double inclination = model.inclination_deg * kDegToRad;
-  return model.field_ut * Eigen::Vector3d(std::cos(inclination) * std::cos(declination),
-                                          std::cos(inclination) * std::sin(declination),
-                                          std::sin(inclination));
-}
-
 core::Geodetic originOf(const NavNodeParams& params) {
   return core::geodeticFromDegrees(params.origin_lat_deg, params.origin_lon_deg,
                                    params.origin_alt_m);
@@ -149,7 +141,9 @@ NavNode::NavNode(core::Bus& bus, const NavNodeParams& params, GroundDown ground_
       params_(params),
       frame_(originOf(params)),
       ground_down_(params.range_against_map ? std::move(ground_down) : GroundDown{}),
-      earth_field_ned_ut_(earthField_ned_ut(params.sensors)) {
+      earth_field_ned_ut_(core::magneticField_ned(params.sensors.declination_deg,
+                                                  params.sensors.inclination_deg,
+                                                  params.sensors.field_ut)) {
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "nav");
   if (params_.range_against_map && !ground_down_)
     throw core::ParamError("nav.range_against_map: no map of the ground was given");

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -312,10 +311,7 @@ void MagnetometerParams::visit(core::ParamVisitor& v) {
 }
 
 Eigen::Vector3d earthField_ned_ut(const MagnetometerParams& params) {
-  constexpr double kRad = std::numbers::pi / 180.0;
-  const double d = params.declination_deg * kRad, i = params.inclination_deg * kRad;
-  return params.field_ut *
-         Eigen::Vector3d(std::cos(i) * std::cos(d), std::cos(i) * std::sin(d), std::sin(i));
+  return core::magneticField_ned(params.declination_deg, params.inclination_deg, params.field_ut);
 }
 
 MagnetometerModel::MagnetometerModel(const MagnetometerParams& params)
