@@ -29,6 +29,7 @@ struct SnapshotParams {
   render::TerrainRendererParams renderer;
   render::CameraParams camera;
   std::map<std::string, terrain::GroundTarget> targets;
+  terrain::CourseParams course;
   double north_m = 0.0;
   double east_m = 0.0;
   double agl_m = 300.0;
@@ -42,6 +43,7 @@ struct SnapshotParams {
     core::visitGroup(v, "renderer", "terrain drawing", renderer);
     core::visitGroup(v, "camera", "the camera, looking down from the body", camera);
     core::visitGroupMap(v, "targets", "ground targets by name", targets);
+    core::visitGroup(v, "course", "upright gates, slalom boards and decoys", course);
     v.field("north_m", &north_m,
             {.doc = "body position north of the origin, m", .min = -1e6, .max = 1e6});
     v.field("east_m", &east_m,
@@ -62,7 +64,8 @@ int runSnapshot(const std::string& config_path, const std::vector<std::string>& 
   if (!config_path.empty()) core::applyYamlFile(config_path, visit);
   core::applyAssignments(params, overrides);
 
-  camera::GroundScene scene(params.world, params.tiles, params.renderer, params.targets);
+  camera::GroundScene scene(params.world, params.tiles, params.renderer, params.targets,
+                            params.course);
   const terrain::BuiltWorld& built = scene.built;
   render::CameraRenderer camera(scene.terrain, params.camera);
 

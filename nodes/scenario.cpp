@@ -43,6 +43,8 @@ void ScenarioParams::visit(core::ParamVisitor& v) {
   core::visitGroup(v, "camera", "the main camera (\"down\")", camera);
   core::visitGroupMap(v, "cameras", "more cameras by name", cameras);
   core::visitGroupMap(v, "targets", "ground targets by name", targets);
+  core::visitGroup(v, "course", "upright gates, slalom boards and decoys for a ground rover",
+                   course);
   core::visitGroup(v, "tiles", "terrain tiles and levels of detail", tiles);
   core::visitGroup(v, "renderer", "terrain drawing", renderer);
   for (NodeGroup& group : nodes) core::visitGroup(v, group.name, group.doc, group.params);

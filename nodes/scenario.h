@@ -22,6 +22,7 @@
 #include "nodes/scenario_files.h"
 #include "nodes/sim/sim_params.h"
 #include "render/terrain_renderer.h"
+#include "terrain/course.h"
 #include "terrain/targets.h"
 #include "terrain/tiles.h"
 #include "terrain/world_factory.h"
@@ -48,6 +49,8 @@ struct ScenarioParams {
   camera::CameraSpec camera;
   std::map<std::string, camera::CameraSpec> cameras;
   std::map<std::string, terrain::GroundTarget> targets;
+  // Upright boards for a ground rover: gates, slalom boards, decoys.
+  terrain::CourseParams course;
   terrain::TileParams tiles;
   render::TerrainRendererParams renderer;
   // The processing nodes, in registry order.

@@ -52,6 +52,21 @@ GLuint linkProgram(const std::string& name, const std::string& vertex_source,
   return program;
 }
 
+GLuint uploadRgbTexture(const cv::Mat& rgb, GLenum min_filter) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
+               rgb.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(min_filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return texture;
+}
+
 void checkGl(const char* what) {
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) {

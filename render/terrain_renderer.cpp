@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/course_boards.h"
 #include "render/detail_texture.h"
 #include "render/gl.h"
 #include "render/ground_objects.h"
@@ -105,21 +106,6 @@ double detailRepeat2_m(const terrain::World& world) {
 constexpr double kDetailAngle2_rad = 0.61;
 
 // An 8-bit RGB image as a mipmapped, edge-clamped texture.
-GLuint uploadRgbTexture(const cv::Mat& rgb, GLenum min_filter) {
-  GLuint texture = 0;
-  glGenTextures(1, &texture);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
-               rgb.data);
-  glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(min_filter));
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return texture;
-}
-
 double positiveMod(double value, double period) {
   const double r = std::fmod(value, period);
   return r < 0.0 ? r + period : r;
@@ -258,6 +244,7 @@ TerrainRenderer::~TerrainRenderer() {
   gpu_tiles_.clear();
   targets_.clear();
   objects_.reset();
+  boards_.reset();
   glDeleteProgram(program_target_);
   glDeleteTextures(1, &detail_texture_);
   glDeleteBuffers(1, &index_buffer_);
@@ -303,6 +290,11 @@ void TerrainRenderer::setTargets(const std::vector<terrain::GroundTarget>& targe
     targets_.push_back(std::move(gpu));
   }
   checkGl("uploading ground targets");
+}
+
+void TerrainRenderer::setBoards(const std::vector<terrain::CourseBoard>& boards) {
+  if (!boards_) boards_ = std::make_unique<CourseBoardRenderer>();
+  boards_->setBoards(boards, tiles_->world());
 }
 
 void TerrainRenderer::drawTargets(const DrawView& view, const Eigen::Matrix4d& clip_from_camera) {
@@ -537,6 +529,7 @@ DrawStats TerrainRenderer::draw(const DrawView& view) {
   glBindVertexArray(0);
   if (objects_) drawObjects(view, P, visible, nearest_m, stats);
   drawTargets(view, P);
+  if (boards_) stats.boards = boards_->draw(P, view.T_world_cam, view.near_m, view.gain, view.gray);
   evictBeyondBudget(visible);
   checkGl("drawing the terrain");
   return stats;

@@ -13,12 +13,14 @@
 
 #include "core/params.h"
 #include "render/camera_model.h"
+#include "terrain/course.h"
 #include "terrain/targets.h"
 #include "terrain/tiles.h"
 
 namespace nadir::render {
 
 class GroundObjectRenderer;
+class CourseBoardRenderer;
 
 struct TerrainRendererParams {
   // GPU memory for tile meshes and textures, MiB (system memory on llvmpipe).
@@ -52,6 +54,7 @@ struct DrawStats {
   int triangles = 0;  // the terrain's and the objects'
   int tiles_uploaded = 0;
   int objects = 0;
+  int boards = 0;
 };
 
 class TerrainRenderer {
@@ -67,6 +70,9 @@ class TerrainRenderer {
 
   // Ground targets drawn on top of the terrain from now on (replacing earlier ones).
   void setTargets(const std::vector<terrain::GroundTarget>& targets);
+  // Upright course boards drawn from now on (replacing earlier ones), after the
+  // ground and its targets, depth-tested.
+  void setBoards(const std::vector<terrain::CourseBoard>& boards);
 
   // Tile selection for a view (also what draw() uses).
   std::vector<terrain::TileId> visibleTiles(const DrawView& view);
@@ -96,6 +102,7 @@ class TerrainRenderer {
                    const std::vector<terrain::TileId>& visible,
                    const std::vector<double>& nearest_m, DrawStats& stats);
   std::unique_ptr<GroundObjectRenderer> objects_;
+  std::unique_ptr<CourseBoardRenderer> boards_;
   std::unordered_map<std::uint64_t, std::unique_ptr<GpuTile>> gpu_tiles_;
   std::list<std::uint64_t> lru_;
   std::size_t gpu_bytes_ = 0;

@@ -14,11 +14,12 @@ namespace nadir::terrain {
 
 void WorldParams::visit(core::ParamVisitor& v) {
   v.field("kind", &kind,
-          {.doc = "procedural, files or checkerboard",
-           .choices = {"procedural", "files", "checkerboard"}});
+          {.doc = "procedural, files, checkerboard or arena",
+           .choices = {"procedural", "files", "checkerboard", "arena"}});
   core::visitGroup(v, "procedural", "the procedural world (kind: procedural)", procedural);
   core::visitGroup(v, "checkerboard", "a calibration board on flat ground (kind: checkerboard)",
                    checkerboard);
+  core::visitGroup(v, "arena", "the flat floor of an indoor robot arena (kind: arena)", arena);
   v.field("dem_path", &dem_path, {.doc = "files: elevation (.hgt, GeoTIFF, .asc)"});
   v.field("imagery_path", &imagery_path,
           {.doc = "files: RGB GeoTIFF, or a plain image placed by imagery_bounds_deg"});
@@ -60,6 +61,13 @@ BuiltWorld makeWorld(const WorldParams& params) {
     built.description = "checkerboard, " + std::to_string(board.inner_cols) + "x" +
                         std::to_string(board.inner_rows) + " inner corners, " +
                         std::to_string(board.square_m) + " m squares";
+    return built;
+  }
+  if (params.kind == "arena") {
+    built.world = std::make_shared<ArenaWorld>(params.arena);
+    built.description = "arena floor, " +
+                        std::to_string(static_cast<int>(2.0 * params.arena.half_size_m)) +
+                        " m square";
     return built;
   }
   if (params.dem_path.empty()) throw core::ParamError("world.dem_path: a files world needs a DEM");

@@ -8,6 +8,7 @@
 
 #include "core/geodesy.h"
 #include "core/params.h"
+#include "terrain/arena_world.h"
 #include "terrain/checkerboard_world.h"
 #include "terrain/procedural_world.h"
 #include "terrain/world.h"
@@ -15,10 +16,12 @@
 namespace nadir::terrain {
 
 struct WorldParams {
-  // "procedural", "files" or "checkerboard" (a calibration board on flat ground).
+  // "procedural", "files", "checkerboard" (a calibration board on flat ground)
+  // or "arena" (the flat floor of an indoor robot arena).
   std::string kind = "procedural";
   ProceduralWorldParams procedural;
   CheckerboardParams checkerboard;
+  ArenaParams arena;
   // files: a DEM (.hgt, GeoTIFF, ESRI .asc).
   std::string dem_path;
   // files: imagery as one RGB GeoTIFF, or a plain image with imagery_bounds_deg;

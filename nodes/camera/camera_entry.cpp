@@ -64,6 +64,7 @@ class CameraEntry final : public TypedEntry<CameraNodeParams> {
     params.renderer = scenario.renderer;
     params.cameras = scenario.allCameras();
     params.targets = scenario.targets;
+    params.course = scenario.course;
     return params;
   }
   std::unique_ptr<Node> build(core::Bus& bus, const CameraNodeParams& params) const override {

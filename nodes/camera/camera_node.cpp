@@ -6,7 +6,7 @@ namespace nadir::camera {
 
 CameraNode::CameraNode(core::Bus& bus, const CameraNodeParams& params)
     : bus_(bus),
-      scene_(params.world, params.tiles, params.renderer, params.targets),
+      scene_(params.world, params.tiles, params.renderer, params.targets, params.course),
       rig_(scene_.terrain, params.cameras) {
   subscription_ = msg::subscribe<msg::Pose>(
       bus_, params.pose_channel, [this](const msg::Pose& pose) { onPose(pose); },

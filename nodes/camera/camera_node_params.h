@@ -7,6 +7,7 @@
 #include "core/params.h"
 #include "nodes/camera/camera_rig.h"
 #include "render/terrain_renderer.h"
+#include "terrain/course.h"
 #include "terrain/targets.h"
 #include "terrain/tiles.h"
 #include "terrain/world_factory.h"
@@ -21,6 +22,7 @@ struct CameraNodeParams {
   // Cameras by name; none given: one "down" camera with CameraSpec's defaults.
   std::map<std::string, CameraSpec> cameras;
   std::map<std::string, terrain::GroundTarget> targets;
+  terrain::CourseParams course;
 
   void visit(core::ParamVisitor& v) {
     v.field("pose_channel", &pose_channel,
@@ -30,6 +32,7 @@ struct CameraNodeParams {
     core::visitGroup(v, "renderer", "terrain drawing", renderer);
     core::visitGroupMap(v, "cameras", "cameras by name", cameras);
     core::visitGroupMap(v, "targets", "ground targets by name", targets);
+    core::visitGroup(v, "course", "upright gates, slalom boards and decoys", course);
   }
 };
 

@@ -49,7 +49,7 @@ std::array<std::array<double, 2>, 4> diskCentres(int x0, int y0) {
 }
 
 void expectCentres(const GateResult& result, int x0, int y0) {
-  ASSERT_TRUE(result.detected);
+  ASSERT_TRUE(result.detected());
   const auto expected = diskCentres(x0, y0);
   for (int i = 0; i < 4; ++i) {
     EXPECT_NEAR(result.disk_centres_px[i][0], expected[i][0], 1.5) << "disk " << i;
@@ -111,17 +111,17 @@ TEST(GateTrackerTest, BrokenSquaresUseThePreviousCentres) {
 // Broken squares and no previous centres (or after reset()): nothing found.
 TEST(GateTrackerTest, BrokenSquaresWithoutHistoryFindNothing) {
   GateTracker tracker{GateTrackerParams{}};
-  EXPECT_FALSE(track(tracker, gateScene(4, 60, 50, true, false)).detected);
-  ASSERT_TRUE(track(tracker, gateScene(4, 60, 50, false, false)).detected);
+  EXPECT_FALSE(track(tracker, gateScene(4, 60, 50, true, false)).detected());
+  ASSERT_TRUE(track(tracker, gateScene(4, 60, 50, false, false)).detected());
   tracker.reset();
-  EXPECT_FALSE(track(tracker, gateScene(4, 60, 50, true, false)).detected);
+  EXPECT_FALSE(track(tracker, gateScene(4, 60, 50, true, false)).detected());
 }
 
 // A scene without a gate has no gate.
 TEST(GateTrackerTest, NothingWithoutAGate) {
   for (std::uint32_t seed = 1; seed <= 5; ++seed) {
     GateTracker tracker{GateTrackerParams{}};
-    EXPECT_FALSE(track(tracker, test::clutterScene(seed, 60, 40)).detected) << "seed " << seed;
+    EXPECT_FALSE(track(tracker, test::clutterScene(seed, 60, 40)).detected()) << "seed " << seed;
   }
 }
 
