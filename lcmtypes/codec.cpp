@@ -16,6 +16,8 @@
 #include "nadir/body_rates_t.hpp"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/camera_info_v1_t.hpp"
+#include "nadir/drive_command_t.hpp"
+#include "nadir/gate_pattern_t.hpp"
 #include "nadir/geodetic_position_t.hpp"
 #include "nadir/gps_t.hpp"
 #include "nadir/heartbeat_t.hpp"
@@ -306,6 +308,14 @@ struct LcmOf<TargetDetection> {
 template <>
 struct LcmOf<VoCommand> {
   using type = nadir::vo_command_t;
+};
+template <>
+struct LcmOf<GatePattern> {
+  using type = nadir::gate_pattern_t;
+};
+template <>
+struct LcmOf<DriveCommand> {
+  using type = nadir::drive_command_t;
 };
 template <>
 struct LcmOf<Heartbeat> {
@@ -836,6 +846,85 @@ TargetDetection decode<TargetDetection>(const void* data, std::size_t size) {
   return out;
 }
 
+Bytes encode(const GatePattern& message) {
+  nadir::gate_pattern_t out{};
+  out.utime = message.utime;
+  // PatternKind lists gate_pattern_t's KIND_* values in their order.
+  out.kind = static_cast<std::int8_t>(message.kind);
+  for (const Eigen::Vector2d& disk : message.disks_px) out.disks_px.push_back({disk.x(), disk.y()});
+  out.num_disks = static_cast<std::int32_t>(out.disks_px.size());
+  out.squares_intact = message.squares_intact;
+  out.patterns_in_view = message.patterns_in_view;
+  out.threshold_instructions = message.threshold_instructions;
+  out.flood_instructions = message.flood_instructions;
+  out.denoise_instructions = message.denoise_instructions;
+  out.coordinates_instructions = message.coordinates_instructions;
+  out.chip_time_s = message.chip_time_s;
+  return toBytes(out);
+}
+
+Bytes encode(const DriveCommand& message) {
+  nadir::drive_command_t out{};
+  out.utime = message.utime;
+  out.frame_utime = message.frame_utime;
+  out.steer_rad = message.steer_rad;
+  out.speed_mps = message.speed_mps;
+  // DriveCommand::Mode lists drive_command_t's MODE_* values in their order.
+  out.mode = static_cast<std::int8_t>(message.mode);
+  out.lateral_error_rad = message.lateral_error_rad;
+  out.deformation = message.deformation;
+  return toBytes(out);
+}
+
+template <>
+GatePattern decode<GatePattern>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::gate_pattern_t>(data, size);
+  const std::string at = where(in);
+  GatePattern out;
+  out.utime = in.utime;
+  out.kind = enumFromWire<PatternKind>(in.kind, 4, "kind", at);
+  for (const std::vector<double>& disk : in.disks_px) {
+    requireFinite(disk.data(), 2, "disks_px", at);
+    out.disks_px.emplace_back(disk[0], disk[1]);
+  }
+  const std::size_t wanted = out.kind == PatternKind::GATE   ? 4
+                             : out.kind == PatternKind::NONE ? out.disks_px.size()
+                                                             : 3;
+  if (out.disks_px.size() != wanted) {
+    throw InvalidMessage(at + ": num_disks " + std::to_string(out.disks_px.size()) +
+                         " does not fit the pattern's kind (" + std::to_string(wanted) + ")");
+  }
+  out.squares_intact = in.squares_intact;
+  out.patterns_in_view = in.patterns_in_view;
+  out.threshold_instructions = in.threshold_instructions;
+  out.flood_instructions = in.flood_instructions;
+  out.denoise_instructions = in.denoise_instructions;
+  out.coordinates_instructions = in.coordinates_instructions;
+  out.chip_time_s = in.chip_time_s;
+  requireFinite(in.chip_time_s, "chip_time_s", at);
+  return out;
+}
+
+template <>
+DriveCommand decode<DriveCommand>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::drive_command_t>(data, size);
+  const std::string at = where(in);
+  DriveCommand out;
+  out.utime = in.utime;
+  out.frame_utime = in.frame_utime;
+  requireFinite(in.steer_rad, "steer_rad", at);
+  requireFinite(in.speed_mps, "speed_mps", at);
+  if (in.speed_mps < 0.0) {
+    throw InvalidMessage(at + ": speed_mps " + std::to_string(in.speed_mps) + " is negative");
+  }
+  out.steer_rad = in.steer_rad;
+  out.speed_mps = in.speed_mps;
+  out.mode = enumFromWire<DriveCommand::Mode>(in.mode, 5, "mode", at);
+  out.lateral_error_rad = in.lateral_error_rad;
+  out.deformation = in.deformation;
+  return out;
+}
+
 template <>
 VoCommand decode<VoCommand>(const void* data, std::size_t size) {
   const auto in = fromBytes<nadir::vo_command_t>(data, size);
@@ -891,6 +980,8 @@ NADIR_MSG_TYPE(NavState)
 NADIR_MSG_TYPE(PpaOdometry)
 NADIR_MSG_TYPE(TargetDetection)
 NADIR_MSG_TYPE(VoCommand)
+NADIR_MSG_TYPE(GatePattern)
+NADIR_MSG_TYPE(DriveCommand)
 NADIR_MSG_TYPE(Heartbeat)
 #undef NADIR_MSG_TYPE
 
@@ -901,7 +992,7 @@ std::string typeName(const void* data, std::size_t size) {
                  nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t,
                  nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t, nadir::nav_state_t,
                  nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
-                 nadir::heartbeat_t>();
+                 nadir::gate_pattern_t, nadir::drive_command_t, nadir::heartbeat_t>();
   const std::int64_t hash = fingerprintOf(data, size);
   for (const KnownType& type : kTypes) {
     if (type.hash == hash) return type.name;

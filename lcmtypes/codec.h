@@ -50,6 +50,8 @@ Bytes encode(const NavState& message);
 Bytes encode(const PpaOdometry& message);
 Bytes encode(const TargetDetection& message);
 Bytes encode(const VoCommand& message);
+Bytes encode(const GatePattern& message);
+Bytes encode(const DriveCommand& message);
 Bytes encode(const Heartbeat& message);
 
 template <class T>

@@ -210,6 +210,36 @@ struct TargetDetection {
   std::vector<Eigen::Vector2d> points_px;
 };
 
+enum class PatternKind { NONE, GATE, SLALOM_LEFT, SLALOM_RIGHT };
+
+// gate_pattern_t: the gate or slalom pattern the PPA found in one frame.
+struct GatePattern {
+  std::int64_t utime = 0;
+  PatternKind kind = PatternKind::NONE;
+  // A gate's four disk centres (top-left, top-right, bottom-left,
+  // bottom-right) or a slalom board's three (column top, bottom, tip), px.
+  std::vector<Eigen::Vector2d> disks_px;
+  bool squares_intact = false;
+  int patterns_in_view = 0;
+  std::int64_t threshold_instructions = 0;
+  std::int64_t flood_instructions = 0;
+  std::int64_t denoise_instructions = 0;
+  std::int64_t coordinates_instructions = 0;
+  double chip_time_s = 0.0;
+};
+
+// drive_command_t: steering and speed for a ground vehicle.
+struct DriveCommand {
+  enum class Mode { TRACKING, COASTING, STOPPING, MANOEUVRE, STOPPED };
+  std::int64_t utime = 0;        // takes effect
+  std::int64_t frame_utime = 0;  // the frame it came from
+  double steer_rad = 0.0;        // positive turns right
+  double speed_mps = 0.0;
+  Mode mode = Mode::STOPPED;
+  double lateral_error_rad = 0.0;
+  double deformation = 0.0;
+};
+
 // vo_command_t: a command to the VO nodes (target: a source name, or empty for all).
 struct VoCommand {
   enum class Kind { RESET };

@@ -11,6 +11,7 @@ std::unique_ptr<Entry> ppaEntry();
 std::unique_ptr<Entry> voFeatureEntry();
 std::unique_ptr<Entry> voDirectEntry();
 std::unique_ptr<Entry> navEntry();
+std::unique_ptr<Entry> controlEntry();
 std::unique_ptr<Entry> simEntry();
 
 bool Node::turn(core::Bus& bus) {
@@ -26,6 +27,7 @@ const std::vector<std::unique_ptr<Entry>>& registry() {
     list.push_back(voFeatureEntry());
     list.push_back(voDirectEntry());
     list.push_back(navEntry());
+    list.push_back(controlEntry());
     list.push_back(simEntry());
     return list;
   }();

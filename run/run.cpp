@@ -115,6 +115,7 @@ RunResult runScenario(const RunOptions& options,
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
+  sim::DriveCommandInput drive_commands(*bus, scenario.sim, simulator);
   std::vector<std::unique_ptr<nodes::Node>> running;
   for (const auto& [entry, params] : running_nodes) {
     if (entry->info().role == nodes::EntryInfo::Role::kProcessing) {

@@ -106,8 +106,8 @@ double reflectance(const PatternSpec& spec, double x, double y) {
 // apart, so that the next gate is never more than about 15 deg off the way a
 // vehicle leaves the last one.
 constexpr int kGates = 8;
-constexpr double kGateSpacing_m = 2.8;
-constexpr double kGateWave_m = 0.7;
+constexpr double kGateSpacing_m = 3.0;
+constexpr double kGateWave_m = 0.35;
 
 }  // namespace
 

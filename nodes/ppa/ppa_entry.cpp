@@ -103,6 +103,7 @@ class PpaEntry final : public TypedEntry<PpaProcessParams> {
     return std::make_unique<PpaLiveNode>(bus, params);
   }
   std::vector<Stream> publishes(const PpaProcessParams& params) const override {
+    if (params.node.mode == "gates") return {{.channel = params.node.pattern_channel}};
     return {{.channel = params.node.pose_channel},
             {.channel = params.node.odometry_channel},
             {.channel = params.node.target_channel}};
@@ -111,7 +112,10 @@ class PpaEntry final : public TypedEntry<PpaProcessParams> {
   // Passes over the known targets with the chip's detections and the errors
   // around them (target_passes.csv beside the run).
   std::string report(const BatchReportInput& input, const PpaProcessParams& params) const override {
-    if (!params.node.target_extraction || params.known_targets_ne_m.empty()) return {};
+    if (params.node.mode != "odometry" || !params.node.target_extraction ||
+        params.known_targets_ne_m.empty()) {
+      return {};
+    }
     const logs::LogTrajectories& recorded = input.recorded;
     if (recorded.sources.count(info().name) == 0) return {};
     ppa::TargetPassInput passes;

@@ -24,6 +24,9 @@ void visitArray(core::ParamVisitor& v, PpaParams& array) {
 
 void PpaNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the PPA emulator in this scenario"});
+  v.field("mode", &mode,
+          {.doc = "odometry (VO and target extraction) or gates (gate and slalom patterns)",
+           .choices = {"odometry", "gates"}});
   v.field("image_channel", &image_channel, {.doc = "the PPA camera's 256x256 gray images"});
   v.field("info_channel", &info_channel, {.doc = "its camera_info_t (the lens)"});
   v.field("range_channel", &range_channel, {.doc = "range_t: height above ground"});
@@ -33,6 +36,7 @@ void PpaNodeParams::visit(core::ParamVisitor& v) {
   v.field("pose_channel", &pose_channel, {.doc = "vo_estimate_t out"});
   v.field("odometry_channel", &odometry_channel, {.doc = "ppa_odometry_t out"});
   v.field("target_channel", &target_channel, {.doc = "target_detection_t out"});
+  v.field("pattern_channel", &pattern_channel, {.doc = "gate_pattern_t out (mode gates)"});
   v.field("command_channel", &command_channel,
           {.doc = "vo_command_t in: resets for ppa or for every VO node"});
   v.field("target_extraction", &target_extraction,
@@ -45,6 +49,7 @@ void PpaNodeParams::visit(core::ParamVisitor& v) {
           [this](core::ParamVisitor& inner) { visitArray(inner, array); });
   core::visitGroup(v, "vo", "on-sensor visual odometry", vo);
   core::visitGroup(v, "target", "on-sensor target extraction", target);
+  core::visitGroup(v, "gate", "on-sensor gate and slalom pattern tracking (mode gates)", gate);
   core::visitGroup(v, "host", "pixels to metres, integration, target correction", host);
 }
 
@@ -62,6 +67,7 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
       array_(params.array),
       vo_(params.vo),
       extractor_(params.target),
+      gate_tracker_(params.gate),
       host_(params.host,
             PpaCamera::fromFov(kWidth, kHeight, params.host.hfov_deg * std::numbers::pi / 180.0,
                                core::rotationBodyFromDownCamera()),
@@ -89,6 +95,30 @@ PpaNode::PpaNode(core::Bus& bus, const PpaNodeParams& params,
   subscriptions_.push_back(msg::subscribe<msg::Image>(
       bus_, params_.image_channel, [this](const msg::Image& image) { onImage(image); },
       [this](const std::string& reason) { drop(reason); }));
+}
+
+void PpaNode::trackPattern(std::int64_t utime, const cv::Mat& gray) {
+  array_.setLight(gray.ptr<std::uint8_t>());
+  const GateResult result = gate_tracker_.processFrame(array_);
+  instructions_ += result.instructions;
+  ++frames_;
+  msg::GatePattern pattern;
+  pattern.utime = utime;
+  // GateTracker's PatternKind lists gate_pattern_t's kinds in their order.
+  pattern.kind = static_cast<msg::PatternKind>(static_cast<int>(result.kind));
+  for (int i = 0; i < result.num_disks; ++i) {
+    const auto& disk = result.disk_centres_px[static_cast<std::size_t>(i)];
+    pattern.disks_px.emplace_back(disk[0], disk[1]);
+  }
+  pattern.squares_intact = result.squares_intact;
+  pattern.patterns_in_view = result.patterns_in_view;
+  pattern.threshold_instructions = static_cast<std::int64_t>(result.stages.threshold);
+  pattern.flood_instructions = static_cast<std::int64_t>(result.stages.flood);
+  pattern.denoise_instructions = static_cast<std::int64_t>(result.stages.denoise);
+  pattern.coordinates_instructions = static_cast<std::int64_t>(result.stages.coordinates);
+  pattern.chip_time_s =
+      static_cast<double>(result.instructions) / params_.chip_instruction_rate_hz;
+  msg::publish(bus_, params_.pattern_channel, pattern);
 }
 
 double PpaNode::meanInstructionsPerFrame() const {
@@ -124,6 +154,10 @@ void PpaNode::onImage(const msg::Image& image) {
     return;
   }
   if (!gray.isContinuous()) gray = gray.clone();
+  if (params_.mode == "gates") {
+    trackPattern(image.utime, gray);
+    return;
+  }
   applyResets();
   if (!host_.initialised() && first_truth_ && first_truth_->utime <= image.utime) {
     host_.initialise(first_truth_->p_ned_m);

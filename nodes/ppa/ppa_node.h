@@ -3,7 +3,9 @@
 // PPA camera's frames go through the emulated chip (visual odometry, then
 // target extraction), the host turns the alignment into a position with the
 // rangefinder and the flight controller's attitude, and the node publishes
-// vo_estimate_t, ppa_odometry_t and target_detection_t. A RESET on
+// vo_estimate_t, ppa_odometry_t and target_detection_t; in mode gates the
+// frames go through the gate tracker instead and it publishes gate_pattern_t.
+// A RESET on
 // VO_COMMAND drops the key-frame and restarts the position at the next frame.
 // Bad messages are dropped and counted.
 
@@ -19,6 +21,7 @@
 #include "lcmtypes/messages.h"
 #include "nodes/common/flight_inputs.h"
 #include "nodes/common/vo_command.h"
+#include "nodes/ppa/gate_tracker.h"
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/ppa_host.h"
 #include "nodes/ppa/ppa_node_params.h"
@@ -47,6 +50,8 @@ class PpaNode {
 
  private:
   void onImage(const msg::Image& image);
+  // Mode gates: the frame through the gate tracker, its pattern published.
+  void trackPattern(std::int64_t utime, const cv::Mat& gray);
   void applyResets();
   void drop(const std::string& reason);
 
@@ -55,6 +60,7 @@ class PpaNode {
   Ppa array_;
   VisualOdometry vo_;
   TargetExtractor extractor_;
+  GateTracker gate_tracker_;
   PpaHost host_;
   nodes::FlightInputs inputs_;
   std::optional<msg::Pose> first_truth_;

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/params.h"
+#include "nodes/ppa/gate_tracker.h"
 #include "nodes/ppa/ppa_array.h"
 #include "nodes/ppa/ppa_host.h"
 #include "nodes/ppa/target_extraction.h"
@@ -14,6 +15,9 @@ namespace nadir::ppa {
 struct PpaNodeParams {
   // In a scenario: run the PPA (nadir run composes it, nadir launch starts nadir-ppa).
   bool enabled = false;
+  // "odometry": visual odometry and target extraction (McConville et al. 2020);
+  // "gates": gate and slalom pattern tracking (Liu et al. 2021) on PPA_PATTERN.
+  std::string mode = "odometry";
   std::string image_channel = "CAMERA_PPA";
   std::string info_channel = "CAMERA_PPA_INFO";
   std::string range_channel = "RANGE";
@@ -24,6 +28,8 @@ struct PpaNodeParams {
   std::string pose_channel = "POSE_PPA";
   std::string odometry_channel = "PPA_ODOMETRY";
   std::string target_channel = "PPA_TARGET";
+  // gate_pattern_t out (mode gates).
+  std::string pattern_channel = "PPA_PATTERN";
   // vo_command_t in: resets addressed to ppa or to every VO node.
   std::string command_channel = "VO_COMMAND";
   bool target_extraction = true;
@@ -32,6 +38,7 @@ struct PpaNodeParams {
   PpaParams array;
   VisualOdometryParams vo;
   TargetExtractionParams target;
+  GateTrackerParams gate;
   PpaHostParams host;
 
   void visit(core::ParamVisitor& v);

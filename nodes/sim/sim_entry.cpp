@@ -28,6 +28,7 @@ class SimLiveNode final : public Node {
         simulator_(params.sim, built_.world, frame_,
                    sim::loadFlight(params.sim.flight, frame_, &flight_warning_)),
         publisher_(bus, params.sim, simulator_),
+        commands_(bus, params.sim, simulator_),
         utime_(simulator_.startUtime()),
         last_report_utime_(utime_) {}
 
@@ -63,6 +64,10 @@ class SimLiveNode final : public Node {
     for (const auto& [channel, count] : publisher_.counts()) {
       out << "; " << channel << " " << count;
     }
+    if (simulator_.externalControl()) {
+      out << "; drive commands " << commands_.received();
+      if (commands_.dropped() > 0) out << " (" << commands_.dropped() << " invalid, dropped)";
+    }
     return out.str();
   }
 
@@ -86,6 +91,7 @@ class SimLiveNode final : public Node {
   std::string flight_warning_;
   sim::Simulator simulator_;
   sim::SimPublisher publisher_;
+  sim::DriveCommandInput commands_;
   std::optional<std::chrono::steady_clock::time_point> wall_start_;
   std::int64_t utime_ = 0;
   std::int64_t last_report_utime_ = 0;

@@ -73,4 +73,17 @@ void SimPublisher::publish(const SimOutput& output) {
   }
 }
 
+DriveCommandInput::DriveCommandInput(core::Bus& bus, const SimParams& params,
+                                     Simulator& simulator)
+    : simulator_(simulator) {
+  if (!simulator.externalControl()) return;
+  subscription_ = msg::subscribe<msg::DriveCommand>(
+      bus, params.vehicle.command_channel,
+      [this](const msg::DriveCommand& command) {
+        ++received_;
+        simulator_.drive({command.utime, command.steer_rad, command.speed_mps});
+      },
+      [this](const std::string&) { ++dropped_; });
+}
+
 }  // namespace nadir::sim

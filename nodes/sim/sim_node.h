@@ -1,7 +1,8 @@
 #pragma once
 // The simulator's wiring to a bus, shared by nadir-sim and the batch runner:
 // loading a recorded flight, and publishing each step's truth and sensor
-// samples as messages on the scenario's channels.
+// samples as messages on the scenario's channels, and a rover's drive commands
+// taken from the bus.
 
 #include <cstdint>
 #include <map>
@@ -39,6 +40,21 @@ class SimPublisher {
   SimParams params_;
   const Simulator& simulator_;
   std::map<std::string, std::int64_t> counts_;
+};
+
+// Under external control, the drive commands on vehicle.command_channel go to
+// the simulator; commands that are not valid are dropped and counted.
+class DriveCommandInput {
+ public:
+  DriveCommandInput(core::Bus& bus, const SimParams& params, Simulator& simulator);
+  std::int64_t received() const { return received_; }
+  std::int64_t dropped() const { return dropped_; }
+
+ private:
+  Simulator& simulator_;
+  std::int64_t received_ = 0;
+  std::int64_t dropped_ = 0;
+  std::optional<core::Subscription> subscription_;
 };
 
 }  // namespace nadir::sim

@@ -6,6 +6,16 @@ void VehicleParams::visit(core::ParamVisitor& v) {
   v.field(
       "kind", &kind,
       {.doc = "fixed_wing, multirotor or rover", .choices = {"fixed_wing", "multirotor", "rover"}});
+  v.field("control", &control,
+          {.doc = "route (its own guidance on route.waypoints) or external (rover: obeys "
+                  "drive_command_t on command_channel)",
+           .choices = {"route", "external"}});
+  v.field("command_channel", &command_channel,
+          {.doc = "control external: the drive_command_t channel"});
+  v.field("command_timeout_s", &command_timeout_s,
+          {.doc = "control external: brake to a stop when the newest command is older, s",
+           .min = 0.001,
+           .max = 3600});
   v.field("altitude_agl_m", &altitude_agl_m,
           {.doc = "mission altitude above the start's ground, m", .min = 0, .max = 20000});
   fixed_wing.visit(v);

@@ -19,6 +19,13 @@ namespace nadir::sim {
 struct VehicleParams {
   // "fixed_wing", "multirotor" or "rover".
   std::string kind = "fixed_wing";
+  // "route": the vehicle follows route.waypoints on its own guidance;
+  // "external" (rover only): it obeys drive_command_t on command_channel, each
+  // from its utime on, and brakes to a stop when the newest is older than
+  // command_timeout_s (a receiver's failsafe).
+  std::string control = "route";
+  std::string command_channel = "DRIVE_COMMAND";
+  double command_timeout_s = 0.25;
   // Mission altitude: height above the ground at the start point, m (as an
   // autopilot's altitude relative to home); the height of waypoints that give none.
   double altitude_agl_m = 100.0;

@@ -1,5 +1,6 @@
 #include "nodes/sim/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -71,11 +72,27 @@ Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::Wor
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "simulation");
   const double step_s = 1.0 / params_.truth.rate_hz;
   step_us_ = std::max<std::int64_t>(1, core::utimeFromSeconds(step_s));
+  const VehicleParams& vehicle = params_.vehicle;
+  external_ = !flight_ && vehicle.control == "external";
+  if (external_ && vehicle.kind != "rover") {
+    throw core::ParamError("vehicle.control: external control is for a rover (vehicle.kind: " +
+                           vehicle.kind + ")");
+  }
+  if (external_ && params_.duration_s <= 0.0) {
+    throw core::ParamError(
+        "duration_s: a rover under external control needs a duration (it has no route to end)");
+  }
   if (flight_) {
     start_utime_ = flight_->startUtime();
+  } else if (external_) {
+    const double ground_m = world_->groundUp_m(params_.start.north_m, params_.start.east_m);
+    route_.start_ned_m = {params_.start.north_m, params_.start.east_m, -ground_m};
+    route_.start_heading_rad = params_.start.heading_deg * kDeg;
+    RoverParams p = vehicle.rover;
+    p.step_s = step_s;
+    vehicle_.emplace<Rover>(p, route_.start_ned_m, route_.start_heading_rad);
   } else {
     route_ = resolveRoute(params_, *world_, frame_);
-    const VehicleParams& vehicle = params_.vehicle;
     try {
       if (vehicle.kind == "fixed_wing") {
         FixedWingParams p = vehicle.fixed_wing;
@@ -156,8 +173,44 @@ bool Simulator::vehicleFinished() const {
       vehicle_);
 }
 
+void Simulator::drive(const DriveInput& command) {
+  if (!external_) throw std::logic_error("the simulator's vehicle is not under external control");
+  const auto later = std::upper_bound(
+      pending_commands_.begin(), pending_commands_.end(), command.utime,
+      [](std::int64_t utime, const DriveInput& pending) { return utime < pending.utime; });
+  pending_commands_.insert(later, command);
+}
+
+void Simulator::applyCommands() {
+  auto due = pending_commands_.begin();
+  while (due != pending_commands_.end() && due->utime <= utime_) ++due;
+  if (due != pending_commands_.begin()) {
+    applied_command_ = *(due - 1);
+    pending_commands_.erase(pending_commands_.begin(), due);
+  }
+  Rover& rover = std::get<Rover>(vehicle_);
+  const bool stale =
+      !applied_command_ || utime_ - applied_command_->utime >
+                               core::utimeFromSeconds(params_.vehicle.command_timeout_s);
+  if (stale) {
+    rover.command(applied_command_ ? applied_command_->steer_rad : 0.0, 0.0);
+  } else {
+    rover.command(applied_command_->steer_rad, applied_command_->speed_mps);
+  }
+  if (rover.speed_mps() > 0.0) {
+    rover_moved_ = true;
+    rover_still_since_ = -1;
+  } else if (rover_still_since_ < 0) {
+    rover_still_since_ = utime_;
+  }
+}
+
 bool Simulator::finished() const {
   if (!started_) return false;
+  if (external_ && rover_moved_ && rover_still_since_ >= 0 &&
+      utime_ - rover_still_since_ >= 1'000'000) {
+    return true;
+  }
   if (params_.duration_s > 0.0 &&
       utime_ - start_utime_ >= core::utimeFromSeconds(params_.duration_s)) {
     return true;
@@ -168,6 +221,7 @@ bool Simulator::finished() const {
 SimOutput Simulator::step() {
   if (started_) {
     utime_ += step_us_;
+    if (external_) applyCommands();
     std::visit(
         [](auto& vehicle) {
           if constexpr (!std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {

@@ -35,6 +35,14 @@ struct ResolvedRoute {
 ResolvedRoute resolveRoute(const SimParams& params, const terrain::World& world,
                            const core::LocalNedFrame& frame);
 
+// A steering and speed command for a rover under external control, in effect
+// from utime on.
+struct DriveInput {
+  std::int64_t utime = 0;
+  double steer_rad = 0.0;
+  double speed_mps = 0.0;
+};
+
 // One simulation step: the true state and the sensor samples that fell due.
 struct SimOutput {
   VehicleState truth;
@@ -61,8 +69,15 @@ class Simulator {
   // The first call gives the initial state; each later call advances one step
   // of 1 / truth.rate_hz.
   SimOutput step();
-  // True once the route or the flight has ended or duration_s has passed.
+  // True once the route or the flight has ended or duration_s has passed; under
+  // external control, also once the rover has stood still for a second after
+  // moving.
   bool finished() const;
+  // External control: a command, in effect from its utime (commands are kept
+  // in time order; a command for a time already past takes effect at the
+  // next step). Throws std::logic_error without external control.
+  void drive(const DriveInput& command);
+  bool externalControl() const { return external_; }
 
   std::int64_t startUtime() const { return start_utime_; }
   // Ellipsoid altitude of the start, m: the zero of the NAV relative altitude.
@@ -83,6 +98,12 @@ class Simulator {
   std::optional<FlightReplay> flight_;
   ResolvedRoute route_;
   std::variant<std::monostate, FixedWing, Multirotor, Rover> vehicle_;
+  bool external_ = false;
+  std::vector<DriveInput> pending_commands_;
+  std::optional<DriveInput> applied_command_;
+  bool rover_moved_ = false;
+  std::int64_t rover_still_since_ = -1;
+  void applyCommands();
   std::int64_t step_us_ = 0;
   std::int64_t start_utime_ = 0;
   std::int64_t utime_ = 0;

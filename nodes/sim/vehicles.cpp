@@ -331,6 +331,27 @@ void RoverParams::visit(core::ParamVisitor& v) {
           {.doc = "pure pursuit lookahead, m", .min = 0.01, .max = 100});
   v.field("arrival_radius_m", &arrival_radius_m,
           {.doc = "a waypoint is reached within this distance, m", .min = 0.001, .max = 100});
+  v.field("max_acceleration_mps2", &max_acceleration_mps2,
+          {.doc = "external control: speeding up, m/s^2", .min = 0.01, .max = 100});
+  v.field("max_deceleration_mps2", &max_deceleration_mps2,
+          {.doc = "external control: braking, m/s^2", .min = 0.01, .max = 100});
+  v.field("length_m", &length_m, {.doc = "body length (for collisions), m", .min = 0.01, .max = 20});
+  v.field("width_m", &width_m, {.doc = "body width (for collisions), m", .min = 0.01, .max = 10});
+  v.field("rear_overhang_m", &rear_overhang_m,
+          {.doc = "body's back behind the rear axle, m", .min = 0, .max = 10});
+}
+
+Rover::Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad)
+    : params_(params), external_(true), heading_rad_(heading_rad) {
+  core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "vehicle");
+  checkStep(params_.step_s);
+  state_.p_ned_m = start_ned;
+  state_.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading_rad});
+}
+
+void Rover::command(double steer_rad, double speed_mps) {
+  steer_command_rad_ = steer_rad;
+  speed_command_mps_ = std::max(0.0, speed_mps);
 }
 
 Rover::Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
@@ -349,12 +370,18 @@ void Rover::step() {
   const Eigen::Vector3d previous_velocity = state_.v_ned_mps;
   double speed = 0.0;
   double steer_command = 0.0;
-  if (!finished() &&
+  if (external_) {
+    steer_command = steer_command_rad_;
+    const double change = speed_command_mps_ - speed_mps_;
+    speed_mps_ += std::clamp(change, -params_.max_deceleration_mps2 * dt,
+                             params_.max_acceleration_mps2 * dt);
+    speed = speed_mps_;
+  } else if (!finished() &&
       (horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m)).norm() <=
           params_.arrival_radius_m) {
     ++next_waypoint_;
   }
-  if (!finished()) {
+  if (!external_ && !finished()) {
     speed = speedOf(waypoints_, next_waypoint_, params_.speed_mps);
     // Pure pursuit: the arc through the goal point ahead, curvature 2 sin(alpha) / L.
     const Eigen::Vector2d to_goal =
@@ -370,6 +397,7 @@ void Rover::step() {
   const double max_steer_step = params_.max_steer_rate_dps * kDeg * dt;
   steer_rad_ += std::clamp(std::clamp(steer_command, -max_steer, max_steer) - steer_rad_,
                            -max_steer_step, max_steer_step);
+  speed_mps_ = speed;
   const double yaw_rate_rps = speed * std::tan(steer_rad_) / params_.wheelbase_m;
   heading_rad_ = core::wrapAngle_rad(heading_rad_ + yaw_rate_rps * dt);
   state_.v_ned_mps = speed * Eigen::Vector3d(std::cos(heading_rad_), std::sin(heading_rad_), 0.0);

@@ -131,8 +131,10 @@ class Multirotor {
 };
 
 // Ground rover: kinematic bicycle model (rear-axle reference point) on flat
-// ground at a constant speed, steering limited in angle and rate, following
-// waypoints by pure pursuit (for Liu et al.'s (2021) gate and slalom tasks).
+// ground, steering limited in angle and rate, following waypoints by pure
+// pursuit at a constant speed, or (external) the steering and speed it is
+// commanded, reaching the speed at limited acceleration (for Liu et al.'s
+// (2021) gate and slalom tasks).
 struct RoverParams {
   double speed_mps = 1.0;
   double wheelbase_m = 0.3;
@@ -141,6 +143,14 @@ struct RoverParams {
   double lookahead_m = 1.0;
   // A waypoint counts as reached within this distance.
   double arrival_radius_m = 0.2;
+  // External control: speeding up and braking, m/s^2.
+  double max_acceleration_mps2 = 6.0;
+  double max_deceleration_mps2 = 8.0;
+  // The body's footprint (for collisions): length, width, and how far its
+  // back lies behind the rear axle, m.
+  double length_m = 0.43;
+  double width_m = 0.18;
+  double rear_overhang_m = 0.08;
   // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
 
@@ -154,14 +164,25 @@ class Rover {
   Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad,
         const std::vector<Eigen::Vector3d>& waypoints_ned)
       : Rover(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
+  // Under external control: standing at start_ned until commanded.
+  Rover(const RoverParams& params, const Eigen::Vector3d& start_ned, double heading_rad);
+  // External control: the steering angle (positive turns right) and the speed
+  // to reach; both limited as the params say.
+  void command(double steer_rad, double speed_mps);
   void step();
   const VehicleState& state() const { return state_; }
-  bool finished() const { return next_waypoint_ >= waypoints_.size(); }
+  // Following waypoints: the last one passed; under external control, never.
+  bool finished() const { return !external_ && next_waypoint_ >= waypoints_.size(); }
   double steer_rad() const { return steer_rad_; }
   double heading_rad() const { return heading_rad_; }
+  double speed_mps() const { return speed_mps_; }
 
  private:
   RoverParams params_;
+  bool external_ = false;
+  double steer_command_rad_ = 0.0;
+  double speed_command_mps_ = 0.0;
+  double speed_mps_ = 0.0;
   std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   VehicleState state_;

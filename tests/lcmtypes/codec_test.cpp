@@ -19,6 +19,8 @@
 #include "nadir/baro_t.hpp"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/camera_info_v1_t.hpp"
+#include "nadir/drive_command_t.hpp"
+#include "nadir/gate_pattern_t.hpp"
 #include "nadir/gps_t.hpp"
 #include "nadir/image_t.hpp"
 #include "nadir/imu_t.hpp"
@@ -477,6 +479,92 @@ TEST(Codec, HeartbeatAndCommandRoundTrip) {
   ASSERT_TRUE(command_back.initial_pose.has_value());
   EXPECT_EQ(command_back.initial_pose->p_ned_m, command.initial_pose->p_ned_m);
   EXPECT_FALSE(decode<VoCommand>(encode(VoCommand{})).initial_pose.has_value());
+}
+
+// A gate pattern's disks and stage costs land in gate_pattern_t's fields and
+// come back; a disk count that does not fit the kind is refused.
+TEST(Codec, GatePatternRoundTripAndRefusals) {
+  GatePattern pattern;
+  pattern.utime = 1'000'005'000;
+  pattern.kind = PatternKind::GATE;
+  pattern.disks_px = {{10.5, 20.0}, {30.0, 20.5}, {10.0, 40.0}, {30.5, 40.5}};
+  pattern.squares_intact = true;
+  pattern.patterns_in_view = 2;
+  pattern.threshold_instructions = 11;
+  pattern.flood_instructions = 22;
+  pattern.denoise_instructions = 33;
+  pattern.coordinates_instructions = 44;
+  pattern.chip_time_s = 1.1e-5;
+  const Bytes bytes = encode(pattern);
+  nadir::gate_pattern_t raw;
+  ASSERT_EQ(raw.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  EXPECT_EQ(raw.kind, +nadir::gate_pattern_t::KIND_GATE);
+  EXPECT_EQ(raw.num_disks, 4);
+  EXPECT_EQ(raw.disks_px[3][0], 30.5);
+  EXPECT_EQ(raw.flood_instructions, 22);
+  const GatePattern back = decode<GatePattern>(bytes);
+  EXPECT_EQ(back.kind, PatternKind::GATE);
+  ASSERT_EQ(back.disks_px.size(), 4u);
+  EXPECT_EQ(back.disks_px[1], Eigen::Vector2d(30.0, 20.5));
+  EXPECT_EQ(back.coordinates_instructions, 44);
+  EXPECT_EQ(back.chip_time_s, 1.1e-5);
+  EXPECT_TRUE(back.squares_intact);
+  EXPECT_EQ(back.patterns_in_view, 2);
+
+  pattern.kind = PatternKind::SLALOM_LEFT;  // three disks, not four
+  try {
+    decode<GatePattern>(encode(pattern));
+    FAIL() << "a slalom board with four disks was accepted";
+  } catch (const InvalidMessage& error) {
+    EXPECT_NE(std::string(error.what()).find("num_disks 4"), std::string::npos) << error.what();
+  }
+}
+
+// A drive command comes back whole; a negative speed, a non-finite steering
+// angle or an unknown mode is refused naming the field.
+TEST(Codec, DriveCommandRoundTripAndRefusals) {
+  DriveCommand command;
+  command.utime = 2'000'000;
+  command.frame_utime = 1'999'500;
+  command.steer_rad = -0.25;
+  command.speed_mps = 2.4;
+  command.mode = DriveCommand::Mode::MANOEUVRE;
+  command.lateral_error_rad = 0.01;
+  command.deformation = -0.02;
+  const Bytes bytes = encode(command);
+  nadir::drive_command_t raw;
+  ASSERT_EQ(raw.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  EXPECT_EQ(raw.mode, +nadir::drive_command_t::MODE_MANOEUVRE);
+  EXPECT_EQ(raw.steer_rad, -0.25);
+  const DriveCommand back = decode<DriveCommand>(bytes);
+  EXPECT_EQ(back.utime, command.utime);
+  EXPECT_EQ(back.frame_utime, command.frame_utime);
+  EXPECT_EQ(back.steer_rad, -0.25);
+  EXPECT_EQ(back.speed_mps, 2.4);
+  EXPECT_EQ(back.mode, DriveCommand::Mode::MANOEUVRE);
+  EXPECT_EQ(back.deformation, -0.02);
+
+  const auto refused = [](nadir::drive_command_t bad, const std::string& field) {
+    std::vector<std::uint8_t> data(static_cast<std::size_t>(bad.getEncodedSize()));
+    bad.encode(data.data(), 0, static_cast<int>(data.size()));
+    try {
+      decode<DriveCommand>(data);
+      ADD_FAILURE() << field << " was accepted";
+    } catch (const InvalidMessage& error) {
+      EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+    }
+  };
+  nadir::drive_command_t bad = raw;
+  bad.speed_mps = -1.0;
+  refused(bad, "speed_mps");
+  bad = raw;
+  bad.steer_rad = std::numeric_limits<double>::quiet_NaN();
+  refused(bad, "steer_rad");
+  bad = raw;
+  bad.mode = 9;
+  refused(bad, "mode");
 }
 
 }  // namespace
