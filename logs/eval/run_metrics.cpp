@@ -108,6 +108,47 @@ Json sourceJson(const SourceMetrics& m) {
   return j;
 }
 
+Json courseJson(const logs::CourseMetrics& c) {
+  Json passages = Json::array();
+  for (const logs::BoardPassage& p : c.passages) {
+    passages.push_back(Json{{"kind", p.kind},
+                            {"passed", p.passed},
+                            {"crossed", p.crossed},
+                            {"hit", p.hit},
+                            {"time_s", number(p.time_s)},
+                            {"offset_m", number(p.offset_m)},
+                            {"heading_error_deg", number(p.heading_error_deg)}});
+  }
+  Json stages = Json::array();
+  for (const logs::PipelineStage& s : c.stages) {
+    stages.push_back(Json{{"name", s.name},
+                          {"instructions", number(s.instructions)},
+                          {"chip_us", number(s.chip_us)},
+                          {"paper_us", number(s.paper_us)}});
+  }
+  return Json{{"gates", c.gates},
+              {"gates_passed", c.gates_passed},
+              {"gates_missed", c.gates_missed},
+              {"gates_hit", c.gates_hit},
+              {"slalom_boards", c.slalom_boards},
+              {"slalom_passed", c.slalom_passed},
+              {"slalom_wrong_side", c.slalom_wrong_side},
+              {"slalom_missed", c.slalom_missed},
+              {"slalom_hit", c.slalom_hit},
+              {"decoys_hit", c.decoys_hit},
+              {"distance_m", number(c.distance_m)},
+              {"duration_s", number(c.duration_s)},
+              {"average_speed_mps", number(c.average_speed_mps)},
+              {"peak_speed_mps", number(c.peak_speed_mps)},
+              {"frames", c.frames},
+              {"chip_time_us", number(c.chip_time_us)},
+              {"emulated_fps", number(c.emulated_fps)},
+              {"latency_mean_us", number(c.latency_mean_us)},
+              {"latency_max_us", number(c.latency_max_us)},
+              {"passages", passages},
+              {"stages", stages}};
+}
+
 // Reading: every lookup names the key path and the file when it fails.
 class JsonReader {
  public:
@@ -217,6 +258,57 @@ SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::stri
     m.filter = f;
   }
   return m;
+}
+
+logs::CourseMetrics courseFromJson(const JsonReader& r, const Json& j) {
+  const std::string where = "course";
+  const auto integer = [&](const char* key) { return static_cast<int>(r.count(j, key, where)); };
+  logs::CourseMetrics c;
+  c.gates = integer("gates");
+  c.gates_passed = integer("gates_passed");
+  c.gates_missed = integer("gates_missed");
+  c.gates_hit = integer("gates_hit");
+  c.slalom_boards = integer("slalom_boards");
+  c.slalom_passed = integer("slalom_passed");
+  c.slalom_wrong_side = integer("slalom_wrong_side");
+  c.slalom_missed = integer("slalom_missed");
+  c.slalom_hit = integer("slalom_hit");
+  c.decoys_hit = integer("decoys_hit");
+  c.distance_m = r.number(j, "distance_m", where);
+  c.duration_s = r.number(j, "duration_s", where);
+  c.average_speed_mps = r.number(j, "average_speed_mps", where);
+  c.peak_speed_mps = r.number(j, "peak_speed_mps", where);
+  c.frames = integer("frames");
+  c.chip_time_us = r.number(j, "chip_time_us", where);
+  c.emulated_fps = r.number(j, "emulated_fps", where);
+  c.latency_mean_us = r.number(j, "latency_mean_us", where);
+  c.latency_max_us = r.number(j, "latency_max_us", where);
+  const Json& passages = r.at(j, "passages", where);
+  if (!passages.is_array()) r.fail("course.passages", "is not an array");
+  for (const Json& p : passages) {
+    const std::string here = "course.passages";
+    logs::BoardPassage passage;
+    passage.kind = r.text(p, "kind", here);
+    passage.passed = r.flag(p, "passed", here);
+    passage.crossed = r.flag(p, "crossed", here);
+    passage.hit = r.flag(p, "hit", here);
+    passage.time_s = r.number(p, "time_s", here);
+    passage.offset_m = r.number(p, "offset_m", here);
+    passage.heading_error_deg = r.number(p, "heading_error_deg", here);
+    c.passages.push_back(passage);
+  }
+  const Json& stages = r.at(j, "stages", where);
+  if (!stages.is_array()) r.fail("course.stages", "is not an array");
+  for (const Json& s : stages) {
+    const std::string here = "course.stages";
+    logs::PipelineStage stage;
+    stage.name = r.text(s, "name", here);
+    stage.instructions = r.number(s, "instructions", here);
+    stage.chip_us = r.number(s, "chip_us", here);
+    stage.paper_us = r.number(s, "paper_us", here);
+    c.stages.push_back(stage);
+  }
+  return c;
 }
 
 // ------------------------------------------------------------------ the table
@@ -411,6 +503,7 @@ void writeMetricsJson(const std::string& path, const RunMetrics& metrics,
   Json sources = Json::object();
   for (const auto& [name, source] : metrics.sources) sources[name] = sourceJson(source);
   j["sources"] = sources;
+  if (metrics.course) j["course"] = courseJson(*metrics.course);
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw EvalError(path + ": cannot open the file for writing");
   out << j.dump(2) << "\n";
@@ -451,6 +544,9 @@ RunMetrics readMetricsJson(const std::string& path, EvalOptions* options) {
   if (!sources.is_object()) r.fail("sources", "is not an object");
   for (const auto& [name, source] : sources.items()) {
     metrics.sources[name] = sourceFromJson(r, source, "sources." + name);
+  }
+  if (const auto it = j.find("course"); it != j.end() && !it->is_null()) {
+    metrics.course = courseFromJson(r, *it);
   }
   return metrics;
 }

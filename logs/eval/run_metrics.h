@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "logs/course_metrics.h"
 #include "logs/eval/filter_metrics.h"
 #include "logs/eval/metrics.h"
 #include "logs/eval/trajectory.h"
@@ -58,6 +59,8 @@ struct RunMetrics {
   double truth_duration_s = 0;
   std::size_t truth_poses = 0;
   std::map<std::string, SourceMetrics> sources;
+  // A ground vehicle's course (gates, slalom boards), when the run had one.
+  std::optional<logs::CourseMetrics> course;
 };
 
 // One source against the truth (time-sorted, >= 2 poses, else EvalError).

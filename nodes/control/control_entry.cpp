@@ -2,9 +2,15 @@
 // results it adds to a batch run (gates passed, missed and hit, speeds, the
 // pipeline's time per frame and the camera-to-command latency).
 
+#include <filesystem>
 #include <sstream>
 
+#include "core/lcm_log.h"
+#include "lcmtypes/codec.h"
+#include "logs/eval/run_metrics.h"
 #include "nodes/control/control_node.h"
+#include "nodes/control/course_results.h"
+#include "nodes/ppa/ppa_node_params.h"
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
 
@@ -33,6 +39,27 @@ class ControlLiveNode final : public Node {
  private:
   control::ControlNode node_;
 };
+
+// The PPA's pattern frames and the controller's commands in a recording.
+void readPipeline(const std::string& log_path, const std::string& pattern_channel,
+                  const std::string& command_channel, control::CourseRunInput& input) {
+  core::LcmLogReader reader(log_path);
+  while (const std::optional<core::LogEvent> event = reader.next()) {
+    try {
+      if (event->channel == pattern_channel) {
+        const msg::GatePattern p = msg::decode<msg::GatePattern>(event->data);
+        input.frames.push_back({p.utime, p.threshold_instructions, p.flood_instructions,
+                                p.denoise_instructions, p.coordinates_instructions,
+                                p.chip_time_s});
+      } else if (event->channel == command_channel) {
+        const msg::DriveCommand c = msg::decode<msg::DriveCommand>(event->data);
+        input.commands.push_back({c.frame_utime, c.utime});
+      }
+    } catch (const std::exception&) {
+      // Not a message of the kind the channel should carry: not this run's pipeline.
+    }
+  }
+}
 
 class ControlEntry final : public TypedEntry<ControlNodeParams> {
  public:
@@ -63,6 +90,30 @@ class ControlEntry final : public TypedEntry<ControlNodeParams> {
   }
   std::vector<Stream> publishes(const ControlNodeParams& params) const override {
     return {{.channel = params.command_channel}};
+  }
+
+  // The course scored from the truth (course.* in metrics.json).
+  std::string report(const BatchReportInput& input, const ControlNodeParams& params) const override {
+    control::CourseRunInput course;
+    course.boards = terrain::courseBoards(input.scenario.course);
+    if (course.boards.empty() || input.recorded.truth.size() < 2) return {};
+    course.truth = input.recorded.truth;
+    const sim::RoverParams& rover = input.scenario.sim.vehicle.rover;
+    course.footprint = {rover.length_m, rover.width_m, rover.rear_overhang_m};
+    const auto& ppa = input.scenario.node<ppa::PpaNodeParams>("ppa");
+    course.chip_instruction_rate_hz = ppa.chip_instruction_rate_hz;
+    course.transfer_s = params.transfer_s;
+    course.compute_s = params.compute_s;
+    readPipeline(input.log_path, params.pattern_channel, params.command_channel, course);
+    const logs::CourseMetrics metrics = control::courseResults(course);
+    const std::string path = (std::filesystem::path(input.out_dir) / "metrics.json").string();
+    if (std::filesystem::exists(path)) {
+      eval::EvalOptions options;
+      eval::RunMetrics run = eval::readMetricsJson(path, &options);
+      run.course = metrics;
+      eval::writeMetricsJson(path, run, options);
+    }
+    return control::formatCourse(metrics);
   }
 };
 
