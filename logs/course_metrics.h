@@ -13,8 +13,8 @@ namespace nadir::logs {
 
 // One gate or slalom board of the course, in course order.
 struct BoardPassage {
-  std::string kind;  // gate, slalom_left, slalom_right
-  bool passed = false;  // gate: through its opening; slalom board: by the side it shows
+  std::string kind;      // gate, slalom_left, slalom_right
+  bool passed = false;   // gate: through its opening; slalom board: by the side it shows
   bool crossed = false;  // the board's line was crossed at all
   bool hit = false;      // a post touched
   double time_s = std::numeric_limits<double>::quiet_NaN();  // crossing, from the run's start

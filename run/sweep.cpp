@@ -243,8 +243,82 @@ std::vector<SweepCell> readSweep(const SweepSpec& spec) {
   return cells;
 }
 
+namespace {
+
+bool anyCourse(const std::vector<SweepCell>& cells) {
+  return std::any_of(cells.begin(), cells.end(),
+                     [](const SweepCell& cell) { return cell.metrics && cell.metrics->course; });
+}
+
+// A course's figures in sweep columns, in kCourseColumns' order.
+constexpr const char* kCourseColumns[] = {
+    "course.gates_passed",  "course.gates_missed",      "course.gates_hit",
+    "course.slalom_passed", "course.slalom_wrong_side", "course.slalom_hit",
+    "course.decoys_hit",    "course.average_speed_mps", "course.peak_speed_mps"};
+
+std::vector<std::string> courseCells(const logs::CourseMetrics& c) {
+  return {std::to_string(c.gates_passed) + "/" + std::to_string(c.gates),
+          std::to_string(c.gates_missed),
+          std::to_string(c.gates_hit),
+          std::to_string(c.slalom_passed) + "/" + std::to_string(c.slalom_boards),
+          std::to_string(c.slalom_wrong_side),
+          std::to_string(c.slalom_hit),
+          std::to_string(c.decoys_hit),
+          number(c.average_speed_mps),
+          number(c.peak_speed_mps)};
+}
+
+// The course of each cell, and all cells together.
+std::string courseMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
+  std::string md = "## Course\n\n|";
+  std::string rule = "|";
+  for (const SweepAxis& axis : spec.axes) {
+    md.append(" ").append(axis.key).append(" |");
+    rule += "---|";
+  }
+  for (const char* column : kCourseColumns) {
+    md.append(" ").append(column + 7).append(" |");
+    rule += "---|";
+  }
+  md += "\n" + rule + "\n";
+  int gates = 0, passed = 0, hit = 0, boards = 0, on_side = 0, runs = 0;
+  double slowest = 1e300, fastest_peak = 0.0;
+  for (const SweepCell& cell : cells) {
+    md += "|";
+    for (const std::string& value : cell.values) md.append(" ").append(value).append(" |");
+    if (!cell.metrics || !cell.metrics->course) {
+      for (std::size_t i = 0; i < std::size(kCourseColumns); ++i) md += " - |";
+      md += "\n";
+      continue;
+    }
+    const logs::CourseMetrics& c = *cell.metrics->course;
+    for (const std::string& text : courseCells(c)) md.append(" ").append(text).append(" |");
+    md += "\n";
+    ++runs;
+    gates += c.gates;
+    passed += c.gates_passed;
+    hit += c.gates_hit + c.slalom_hit + c.decoys_hit;
+    boards += c.slalom_boards;
+    on_side += c.slalom_passed;
+    if (std::isfinite(c.average_speed_mps)) slowest = std::min(slowest, c.average_speed_mps);
+    if (std::isfinite(c.peak_speed_mps)) fastest_peak = std::max(fastest_peak, c.peak_speed_mps);
+  }
+  md += "\nAll " + std::to_string(runs) + " runs: " + std::to_string(passed) + " of " +
+        std::to_string(gates) + " gates passed";
+  if (boards > 0)
+    md += ", " + std::to_string(on_side) + " of " + std::to_string(boards) +
+          " slalom boards passed on their side";
+  md += ", " + std::to_string(hit) + " posts hit; lowest average speed " +
+        (runs > 0 ? number(slowest) : std::string("-")) + " m/s, highest peak " +
+        (runs > 0 ? number(fastest_peak) : std::string("-")) + " m/s.\n";
+  return md;
+}
+
+}  // namespace
+
 std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
   const std::vector<std::string> sources = sourceNames(cells);
+  const bool course = anyCourse(cells);
   std::string csv;
   for (const SweepAxis& axis : spec.axes) csv += axis.key + ",";
   csv += "run,truth_track_length_m";
@@ -263,6 +337,9 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
                                  ".nees_position_mean", ".nees_attitude_mean"})
         csv += "," + source + column;
     }
+  }
+  if (course) {
+    for (const char* column : kCourseColumns) csv += std::string(",") + column;
   }
   csv += "\n";
   for (const SweepCell& cell : cells) {
@@ -288,6 +365,13 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
           csv += "," + (std::isfinite(value) ? number(value) : std::string());  // none: empty
       }
     }
+    if (course) {
+      if (cell.metrics && cell.metrics->course) {
+        for (const std::string& text : courseCells(*cell.metrics->course)) csv += "," + text;
+      } else {
+        csv += std::string(std::size(kCourseColumns), ',');
+      }
+    }
     csv += "\n";
   }
   return csv;
@@ -298,6 +382,11 @@ std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& c
   const bool split = spec.axes.size() >= 3;
   const std::size_t first_row_axis = split ? 1 : 0;
   std::string md = "# Sweep: " + spec.scenario + "\n\n";
+  if (anyCourse(cells)) {
+    md += courseMarkdown(spec, cells);
+    if (sources.empty()) return md;
+    md += "\n## Poses\n\n";
+  }
   if (sources.empty()) {
     md += "No pose source (VO node) ran in these cells: the table holds the truth only.\n\n";
   }

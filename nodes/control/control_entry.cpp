@@ -49,8 +49,7 @@ void readPipeline(const std::string& log_path, const std::string& pattern_channe
       if (event->channel == pattern_channel) {
         const msg::GatePattern p = msg::decode<msg::GatePattern>(event->data);
         input.frames.push_back({p.utime, p.threshold_instructions, p.flood_instructions,
-                                p.denoise_instructions, p.coordinates_instructions,
-                                p.chip_time_s});
+                                p.denoise_instructions, p.coordinates_instructions, p.chip_time_s});
       } else if (event->channel == command_channel) {
         const msg::DriveCommand c = msg::decode<msg::DriveCommand>(event->data);
         input.commands.push_back({c.frame_utime, c.utime});
@@ -93,7 +92,8 @@ class ControlEntry final : public TypedEntry<ControlNodeParams> {
   }
 
   // The course scored from the truth (course.* in metrics.json).
-  std::string report(const BatchReportInput& input, const ControlNodeParams& params) const override {
+  std::string report(const BatchReportInput& input,
+                     const ControlNodeParams& params) const override {
     control::CourseRunInput course;
     course.boards = terrain::courseBoards(input.scenario.course);
     if (course.boards.empty() || input.recorded.truth.size() < 2) return {};

@@ -21,10 +21,13 @@ ControlNode::ControlNode(core::Bus& bus, const ControlNodeParams& params)
   core::validateParams([this](core::ParamVisitor& v) { params_.visit(v); }, "control");
   subscriptions_.push_back(msg::subscribe<msg::CameraInfo>(
       bus_, params_.info_channel,
-      [this](const msg::CameraInfo& info) { lens_ = Lens{info.fx, info.fy, info.cx, info.cy}; },
+      [this](const msg::CameraInfo& info) {
+        lens_ = Lens{info.fx, info.fy, info.cx, info.cy};
+      },
       [this](const std::string& reason) { drop(reason); }));
   subscriptions_.push_back(msg::subscribe<msg::GatePattern>(
-      bus_, params_.pattern_channel, [this](const msg::GatePattern& pattern) { onPattern(pattern); },
+      bus_, params_.pattern_channel,
+      [this](const msg::GatePattern& pattern) { onPattern(pattern); },
       [this](const std::string& reason) { drop(reason); }));
 }
 
@@ -47,8 +50,8 @@ void ControlNode::onPattern(const msg::GatePattern& pattern) {
   }
   msg::DriveCommand command;
   command.frame_utime = pattern.utime;
-  command.utime = pattern.utime +
-                  core::utimeFromSeconds(pattern.chip_time_s + params_.transfer_s + params_.compute_s);
+  command.utime = pattern.utime + core::utimeFromSeconds(pattern.chip_time_s + params_.transfer_s +
+                                                         params_.compute_s);
   command.steer_rad = steering.steer_rad;
   command.speed_mps = steering.speed_mps;
   command.mode = static_cast<msg::DriveCommand::Mode>(static_cast<int>(steering.mode));

@@ -37,8 +37,9 @@ std::array<Eigen::Vector2d, 4> corners(const FloorRectangle& r) {
   const Eigen::Vector2d f(std::cos(r.heading_rad), std::sin(r.heading_rad));
   const Eigen::Vector2d s(-f.y(), f.x());
   const Eigen::Vector2d c(r.north_m, r.east_m);
-  return {c + r.half_length_m * f + r.half_width_m * s, c + r.half_length_m * f - r.half_width_m * s,
-          c - r.half_length_m * f - r.half_width_m * s, c - r.half_length_m * f + r.half_width_m * s};
+  return {
+      c + r.half_length_m * f + r.half_width_m * s, c + r.half_length_m * f - r.half_width_m * s,
+      c - r.half_length_m * f - r.half_width_m * s, c - r.half_length_m * f + r.half_width_m * s};
 }
 
 std::string number(double value, int decimals) {
@@ -121,8 +122,7 @@ logs::CourseMetrics courseResults(const CourseRunInput& input) {
       passage.crossed = true;
       passage.time_s = truth[i - 1].t_s + share * (truth[i].t_s - truth[i - 1].t_s) - t0;
       passage.offset_m = lateral;
-      passage.heading_error_deg =
-          core::wrapAngle_rad(body[i].heading_rad - h) / kDeg;
+      passage.heading_error_deg = core::wrapAngle_rad(body[i].heading_rad - h) / kDeg;
       last_crossing_s = std::max(last_crossing_s, passage.time_s);
       if (gate) {
         passage.passed = std::abs(lateral) <= 0.5 * board.opening_m;
@@ -172,9 +172,9 @@ logs::CourseMetrics courseResults(const CourseRunInput& input) {
 
   // The pipeline per frame.
   m.frames = static_cast<int>(input.frames.size());
-  const char* names[6] = {"capture and threshold", "flooding (intact and broken squares)",
-                          "de-noising", "the disks' coordinates", "transfer to the controller",
-                          "PID"};
+  const char* names[6] = {
+      "capture and threshold",  "flooding (intact and broken squares)", "de-noising",
+      "the disks' coordinates", "transfer to the controller",           "PID"};
   double sums[4] = {0, 0, 0, 0}, chip_s = 0.0;
   for (const PatternFrame& frame : input.frames) {
     sums[0] += static_cast<double>(frame.threshold);
@@ -234,15 +234,16 @@ std::string formatCourse(const logs::CourseMetrics& m) {
          number(m.peak_speed_mps, 2) + " m/s\n";
   for (std::size_t i = 0; i < m.passages.size(); ++i) {
     const logs::BoardPassage& p = m.passages[i];
-    out += "  " + std::to_string(i + 1) + " " + p.kind + ": " +
-           (p.passed ? "passed" : p.crossed ? "crossed outside" : "missed") +
-           (p.hit ? ", post hit" : "") + (p.crossed ? " at " + number(p.time_s, 2) + " s, " +
-                                                          number(100.0 * p.offset_m, 1) +
-                                                          " cm off centre, " +
-                                                          number(p.heading_error_deg, 1) +
-                                                          " deg off its axis"
-                                                    : "") +
-           "\n";
+    out +=
+        "  " + std::to_string(i + 1) + " " + p.kind + ": " +
+        (p.passed    ? "passed"
+         : p.crossed ? "crossed outside"
+                     : "missed") +
+        (p.hit ? ", post hit" : "") +
+        (p.crossed ? " at " + number(p.time_s, 2) + " s, " + number(100.0 * p.offset_m, 1) +
+                         " cm off centre, " + number(p.heading_error_deg, 1) + " deg off its axis"
+                   : "") +
+        "\n";
   }
   if (m.frames > 0) {
     out += "pipeline per frame (" + std::to_string(m.frames) +
@@ -261,9 +262,9 @@ std::string formatCourse(const logs::CourseMetrics& m) {
     std::snprintf(line, sizeof line, "  %-40s %10s %9s %10s\n", "total", "",
                   number(chip_total, 1).c_str(), number(paper_total, 0).c_str());
     out += line;
-    out += "emulated chip: " + number(m.emulated_fps, 0) +
-           " frames/s; camera-to-command latency " + number(m.latency_mean_us, 0) +
-           " us mean, " + number(m.latency_max_us, 0) + " us at most\n";
+    out += "emulated chip: " + number(m.emulated_fps, 0) + " frames/s; camera-to-command latency " +
+           number(m.latency_mean_us, 0) + " us mean, " + number(m.latency_max_us, 0) +
+           " us at most\n";
   }
   return out;
 }

@@ -14,7 +14,8 @@ double seconds(std::int64_t us) { return static_cast<double>(us) * 1e-6; }
 }  // namespace
 
 void PidGains::visit(core::ParamVisitor& v) {
-  v.field("kp", &kp, {.doc = "proportional gain, rad of steering per unit of error", .min = -1e3, .max = 1e3});
+  v.field("kp", &kp,
+          {.doc = "proportional gain, rad of steering per unit of error", .min = -1e3, .max = 1e3});
   v.field("ki", &ki, {.doc = "integral gain, per second", .min = -1e3, .max = 1e3});
   v.field("kd", &kd, {.doc = "derivative gain, s", .min = -1e3, .max = 1e3});
   v.field("integral_limit_rad", &integral_limit_rad,
@@ -22,14 +23,16 @@ void PidGains::visit(core::ParamVisitor& v) {
 }
 
 void SlalomParams::visit(core::ParamVisitor& v) {
-  v.field("trigger_m", &trigger_m,
-          {.doc = "distance from a slalom board at which the turn starts, m", .min = 0.05, .max = 100});
+  v.field(
+      "trigger_m", &trigger_m,
+      {.doc = "distance from a slalom board at which the turn starts, m", .min = 0.05, .max = 100});
   v.field("turn_deg", &turn_deg,
           {.doc = "heading change of the turn and of the turn back, deg", .min = 1, .max = 170});
   v.field("straight_m", &straight_m,
           {.doc = "straight between the turn and the turn back, m", .min = 0, .max = 100});
   v.field("column_share", &column_share,
-          {.doc = "distance between the board's column disks, share of its side", .min = 0.01,
+          {.doc = "distance between the board's column disks, share of its side",
+           .min = 0.01,
            .max = 1});
 }
 
@@ -42,12 +45,17 @@ void GateControllerParams::visit(core::ParamVisitor& v) {
                    "PID on delta_y, the pattern's left column height over its right's, minus 1",
                    deformation);
   v.field("reference_x_px", &reference_x_px,
-          {.doc = "the reference pattern's centre column, px; < 0: the image centre", .min = -1,
+          {.doc = "the reference pattern's centre column, px; < 0: the image centre",
+           .min = -1,
            .max = 1e5});
   v.field("max_steer_deg", &max_steer_deg,
           {.doc = "the vehicle's steering lock, deg", .min = 1, .max = 80});
   v.field("wheelbase_m", &wheelbase_m,
           {.doc = "the vehicle's wheelbase (for the slalom's turns), m", .min = 0.01, .max = 10});
+  v.field("max_lateral_acceleration_mps2", &max_lateral_acceleration_mps2,
+          {.doc = "the tyres' grip: slalom turns no tighter than speed^2 / this; 0: the lock's",
+           .min = 0,
+           .max = 1000});
   v.field("coast_s", &coast_s,
           {.doc = "pattern lost: straight on at speed this long, s", .min = 0, .max = 60});
   v.field("stop_s", &stop_s,
@@ -55,14 +63,16 @@ void GateControllerParams::visit(core::ParamVisitor& v) {
   v.field("deformation_filter_s", &deformation_filter_s,
           {.doc = "delta_y's low-pass time constant, s", .min = 0, .max = 10});
   v.field("board_m", &board_m, {.doc = "side of the patterns' boards, m", .min = 0.01, .max = 10});
-  v.field("gate_row_share", &gate_row_share,
-          {.doc = "distance between a gate's disk rows, share of its board", .min = 0.01, .max = 1});
+  v.field(
+      "gate_row_share", &gate_row_share,
+      {.doc = "distance between a gate's disk rows, share of its board", .min = 0.01, .max = 1});
   v.field("commit_m", &commit_m,
-          {.doc = "a gate lost within this distance is driven through straight, m", .min = 0,
+          {.doc = "a gate lost within this distance is driven through straight, m",
+           .min = 0,
            .max = 100});
-  v.field("pass_margin_m", &pass_margin_m,
-          {.doc = "straight on this far beyond a lost gate's last distance, m", .min = 0,
-           .max = 100});
+  v.field(
+      "pass_margin_m", &pass_margin_m,
+      {.doc = "straight on this far beyond a lost gate's last distance, m", .min = 0, .max = 100});
   core::visitGroup(v, "slalom", "slalom boards: when and how to turn", slalom);
 }
 
@@ -153,7 +163,7 @@ SteeringCommand GateController::lost(std::int64_t utime) {
 
 SteeringCommand GateController::manoeuvre(std::int64_t utime) {
   const double t = seconds(utime - manoeuvre_start_);
-  const double lock = params_.max_steer_deg * kDeg;
+  const double lock = manoeuvre_steer_rad_;
   SteeringCommand command;
   command.mode = DriveMode::kManoeuvre;
   command.speed_mps = params_.cruise_speed_mps;
@@ -161,12 +171,24 @@ SteeringCommand GateController::manoeuvre(std::int64_t utime) {
     command.steer_rad = manoeuvre_side_ * lock;
   } else if (t < turn_s_ + straight_s_) {
     command.steer_rad = 0.0;
-  } else if (t < 2.0 * turn_s_ + straight_s_) {
-    command.steer_rad = -manoeuvre_side_ * lock;
   } else {
+    // Turning back towards the line of boards until the next one is in view
+    // (update() takes it from there), blind no longer than lost() allows.
     in_manoeuvre_ = false;
+    returning_ = true;
     last_seen_utime_ = utime;
-    return lost(utime);
+    return returnTurn(utime);
+  }
+  return command;
+}
+
+SteeringCommand GateController::returnTurn(std::int64_t utime) {
+  SteeringCommand command = lost(utime);
+  if (command.speed_mps > 0.0) {
+    command.steer_rad = -manoeuvre_side_ * manoeuvre_steer_rad_;
+    command.mode = DriveMode::kManoeuvre;
+  } else {
+    returning_ = false;
   }
   return command;
 }
@@ -184,16 +206,17 @@ SteeringCommand GateController::update(const PatternObservation& pattern, const 
   if (gate_left && tracking_gate_ && gate_distance_m_ > 0.0 &&
       gate_distance_m_ <= params_.commit_m) {
     tracking_gate_ = false;
-    commit_until_ = pattern.utime +
-                    static_cast<std::int64_t>(1e6 * (gate_distance_m_ + params_.pass_margin_m) /
-                                              std::max(params_.cruise_speed_mps, 0.01));
+    commit_until_ =
+        pattern.utime + static_cast<std::int64_t>(1e6 * (gate_distance_m_ + params_.pass_margin_m) /
+                                                  std::max(params_.cruise_speed_mps, 0.01));
     lateral_.reset();
     deformation_.reset();
     deformation_filtered_ = 0.0;
     return throughGate(pattern.utime);
   }
   tracking_gate_ = false;
-  if (!seen) return lost(pattern.utime);
+  if (!seen) return returning_ ? returnTurn(pattern.utime) : lost(pattern.utime);
+  returning_ = false;
 
   last_seen_utime_ = pattern.utime;
   moving_ = true;
@@ -209,9 +232,10 @@ SteeringCommand GateController::update(const PatternObservation& pattern, const 
   command.deformation = deformation_filtered_;
   command.board_distance_m = patternDistance_m(pattern, lens, params_);
   const double lock = params_.max_steer_deg * kDeg;
-  command.steer_rad = std::clamp(lateral_.step(params_.lateral, command.lateral_error_rad, dt_s) +
-                                     deformation_.step(params_.deformation, command.deformation, dt_s),
-                                 -lock, lock);
+  command.steer_rad =
+      std::clamp(lateral_.step(params_.lateral, command.lateral_error_rad, dt_s) +
+                     deformation_.step(params_.deformation, command.deformation, dt_s),
+                 -lock, lock);
   if (pattern.kind == Pattern::kGate) {
     tracking_gate_ = true;
     gate_distance_m_ = command.board_distance_m;
@@ -219,9 +243,14 @@ SteeringCommand GateController::update(const PatternObservation& pattern, const 
   const bool slalom = pattern.kind == Pattern::kSlalomLeft || pattern.kind == Pattern::kSlalomRight;
   if (slalom) {
     if (command.board_distance_m > 0.0 && command.board_distance_m <= params_.slalom.trigger_m) {
-      // A turn at full lock on a circle of radius L / tan(lock).
-      const double radius_m = params_.wheelbase_m / std::tan(lock);
+      // A turn at full lock on a circle of radius L / tan(lock), or as tight
+      // as the grip allows at this speed.
       const double speed = std::max(params_.cruise_speed_mps, 0.01);
+      double radius_m = params_.wheelbase_m / std::tan(lock);
+      if (params_.max_lateral_acceleration_mps2 > 0.0) {
+        radius_m = std::max(radius_m, speed * speed / params_.max_lateral_acceleration_mps2);
+      }
+      manoeuvre_steer_rad_ = std::atan(params_.wheelbase_m / radius_m);
       turn_s_ = params_.slalom.turn_deg * kDeg * radius_m / speed;
       straight_s_ = params_.slalom.straight_m / speed;
       manoeuvre_side_ = pattern.kind == Pattern::kSlalomRight ? 1.0 : -1.0;

@@ -19,8 +19,10 @@
 // stop_s: it never drives on blind at speed. A slalom board is tracked the same way until its
 // distance (from its disk column's height in the image) falls to
 // slalom.trigger_m; then the rover turns to the side the board shows by
-// slalom.turn_deg at full lock, goes straight for slalom.straight_m and turns
-// back, on its own commands (no other sensor), and looks for the next board.
+// slalom.turn_deg (at full lock, or as tight as its tyres hold at its speed),
+// goes straight for slalom.straight_m, all on its own commands (no other
+// sensor), and turns back the other way until the next board is in view
+// (blind no longer than coast_s and stop_s allow).
 // docs/closed_loop.md has the method and the figures.
 
 #include <cstdint>
@@ -67,6 +69,9 @@ struct GateControllerParams {
   // The vehicle: its steering lock and wheelbase (for the slalom's turns).
   double max_steer_deg = 30.0;
   double wheelbase_m = 0.26;
+  // The tyres' grip, m/s^2: the slalom's turns are planned no tighter than
+  // speed^2 / this; 0: as tight as the lock allows.
+  double max_lateral_acceleration_mps2 = 0.0;
   // Pattern lost: straight on at speed for coast_s, then to a stop over stop_s.
   double coast_s = 0.4;
   double stop_s = 0.5;
@@ -114,8 +119,7 @@ struct SteeringCommand {
 double patternDistance_m(const PatternObservation& pattern, const Lens& lens,
                          const GateControllerParams& params);
 // The pattern's D_y (rad) and delta_y for a lens and reference column.
-double lateralError_rad(const PatternObservation& pattern, const Lens& lens,
-                        double reference_x_px);
+double lateralError_rad(const PatternObservation& pattern, const Lens& lens, double reference_x_px);
 double deformationOf(const PatternObservation& pattern);
 
 class GateController {
@@ -138,6 +142,7 @@ class GateController {
   SteeringCommand manoeuvre(std::int64_t utime);
   SteeringCommand lost(std::int64_t utime);
   SteeringCommand throughGate(std::int64_t utime);
+  SteeringCommand returnTurn(std::int64_t utime);
 
   GateControllerParams params_;
   Pid lateral_, deformation_;
@@ -156,6 +161,9 @@ class GateController {
   std::int64_t manoeuvre_start_ = 0;
   double manoeuvre_side_ = 0.0;
   double turn_s_ = 0.0, straight_s_ = 0.0;
+  double manoeuvre_steer_rad_ = 0.0;
+  // After a slalom turn: turning back until the next board is in view.
+  bool returning_ = false;
 };
 
 }  // namespace nadir::control

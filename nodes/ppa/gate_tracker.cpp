@@ -183,8 +183,8 @@ GateResult GateTracker::processFrame(Ppa& ppa) {
   }
   stage(result.stages.denoise);
 
-  // One pattern at a time; the largest wins (the nearest board), or with a
-  // pattern tracked, the one nearest to it.
+  // One pattern at a time; the largest wins: the nearest board, the one to
+  // steer by now (a farther one comes next).
   std::vector<GateResult> found;
   const std::vector<BoundingBox> areas =
       extractComponents(program, kInner, kPoint, kTmp, params_.max_components);
@@ -211,15 +211,9 @@ GateResult GateTracker::processFrame(Ppa& ppa) {
   }
   result.patterns_in_view = static_cast<int>(found.size());
   if (!found.empty()) {
-    const bool tracking = previous_.detected();
-    const auto score = [&](const GateResult& r) {
-      if (!tracking) return -static_cast<double>(side(r.box));
-      const auto a = centre(r.box), b = centre(previous_.box);
-      return std::hypot(a[0] - b[0], a[1] - b[1]);
-    };
-    const GateResult& best = *std::min_element(
+    const GateResult& best = *std::max_element(
         found.begin(), found.end(),
-        [&](const GateResult& a, const GateResult& b) { return score(a) < score(b); });
+        [](const GateResult& a, const GateResult& b) { return side(a.box) < side(b.box); });
     result.kind = best.kind;
     result.box = best.box;
     result.num_disks = best.num_disks;

@@ -3,7 +3,8 @@
 // 2021, algorithms 1 and 2), written as a kernel of Ppa instructions. A gate's
 // pattern is four black disks inside two concentric black squares; a slalom
 // board's is three disks (two in a column and one beside them: the side to
-// turn to) inside the same squares.
+// turn to) inside the same squares. Of several patterns in view the largest
+// (the nearest) is tracked.
 //
 // Each frame: binarise (dark = 1); flood-and-invert from the bright set
 // `boundaries` - 1 times, which on a bright surround leaves each pattern's

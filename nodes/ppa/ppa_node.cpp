@@ -116,8 +116,7 @@ void PpaNode::trackPattern(std::int64_t utime, const cv::Mat& gray) {
   pattern.flood_instructions = static_cast<std::int64_t>(result.stages.flood);
   pattern.denoise_instructions = static_cast<std::int64_t>(result.stages.denoise);
   pattern.coordinates_instructions = static_cast<std::int64_t>(result.stages.coordinates);
-  pattern.chip_time_s =
-      static_cast<double>(result.instructions) / params_.chip_instruction_rate_hz;
+  pattern.chip_time_s = static_cast<double>(result.instructions) / params_.chip_instruction_rate_hz;
   msg::publish(bus_, params_.pattern_channel, pattern);
 }
 

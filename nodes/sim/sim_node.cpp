@@ -73,8 +73,7 @@ void SimPublisher::publish(const SimOutput& output) {
   }
 }
 
-DriveCommandInput::DriveCommandInput(core::Bus& bus, const SimParams& params,
-                                     Simulator& simulator)
+DriveCommandInput::DriveCommandInput(core::Bus& bus, const SimParams& params, Simulator& simulator)
     : simulator_(simulator) {
   if (!simulator.externalControl()) return;
   subscription_ = msg::subscribe<msg::DriveCommand>(

@@ -75,8 +75,8 @@ Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::Wor
   const VehicleParams& vehicle = params_.vehicle;
   external_ = !flight_ && vehicle.control == "external";
   if (external_ && vehicle.kind != "rover") {
-    throw core::ParamError("vehicle.control: external control is for a rover (vehicle.kind: " +
-                           vehicle.kind + ")");
+    throw core::ParamError(
+        "vehicle.control: external control is for a rover (vehicle.kind: " + vehicle.kind + ")");
   }
   if (external_ && params_.duration_s <= 0.0) {
     throw core::ParamError(
@@ -190,8 +190,8 @@ void Simulator::applyCommands() {
   }
   Rover& rover = std::get<Rover>(vehicle_);
   const bool stale =
-      !applied_command_ || utime_ - applied_command_->utime >
-                               core::utimeFromSeconds(params_.vehicle.command_timeout_s);
+      !applied_command_ ||
+      utime_ - applied_command_->utime > core::utimeFromSeconds(params_.vehicle.command_timeout_s);
   if (stale) {
     rover.command(applied_command_ ? applied_command_->steer_rad : 0.0, 0.0);
   } else {

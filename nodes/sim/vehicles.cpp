@@ -335,7 +335,12 @@ void RoverParams::visit(core::ParamVisitor& v) {
           {.doc = "external control: speeding up, m/s^2", .min = 0.01, .max = 100});
   v.field("max_deceleration_mps2", &max_deceleration_mps2,
           {.doc = "external control: braking, m/s^2", .min = 0.01, .max = 100});
-  v.field("length_m", &length_m, {.doc = "body length (for collisions), m", .min = 0.01, .max = 20});
+  v.field("max_lateral_acceleration_mps2", &max_lateral_acceleration_mps2,
+          {.doc = "the tyres' grip: curvature held to this over speed squared; 0: no limit",
+           .min = 0,
+           .max = 1000});
+  v.field("length_m", &length_m,
+          {.doc = "body length (for collisions), m", .min = 0.01, .max = 20});
   v.field("width_m", &width_m, {.doc = "body width (for collisions), m", .min = 0.01, .max = 10});
   v.field("rear_overhang_m", &rear_overhang_m,
           {.doc = "body's back behind the rear axle, m", .min = 0, .max = 10});
@@ -373,12 +378,12 @@ void Rover::step() {
   if (external_) {
     steer_command = steer_command_rad_;
     const double change = speed_command_mps_ - speed_mps_;
-    speed_mps_ += std::clamp(change, -params_.max_deceleration_mps2 * dt,
-                             params_.max_acceleration_mps2 * dt);
+    speed_mps_ +=
+        std::clamp(change, -params_.max_deceleration_mps2 * dt, params_.max_acceleration_mps2 * dt);
     speed = speed_mps_;
   } else if (!finished() &&
-      (horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m)).norm() <=
-          params_.arrival_radius_m) {
+             (horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m)).norm() <=
+                 params_.arrival_radius_m) {
     ++next_waypoint_;
   }
   if (!external_ && !finished()) {
@@ -398,7 +403,12 @@ void Rover::step() {
   steer_rad_ += std::clamp(std::clamp(steer_command, -max_steer, max_steer) - steer_rad_,
                            -max_steer_step, max_steer_step);
   speed_mps_ = speed;
-  const double yaw_rate_rps = speed * std::tan(steer_rad_) / params_.wheelbase_m;
+  double curvature = std::tan(steer_rad_) / params_.wheelbase_m;
+  if (params_.max_lateral_acceleration_mps2 > 0.0 && speed > 0.0) {
+    const double grip = params_.max_lateral_acceleration_mps2 / (speed * speed);
+    curvature = std::clamp(curvature, -grip, grip);
+  }
+  const double yaw_rate_rps = speed * curvature;
   heading_rad_ = core::wrapAngle_rad(heading_rad_ + yaw_rate_rps * dt);
   state_.v_ned_mps = speed * Eigen::Vector3d(std::cos(heading_rad_), std::sin(heading_rad_), 0.0);
   state_.p_ned_m += state_.v_ned_mps * dt;

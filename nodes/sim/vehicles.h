@@ -146,6 +146,9 @@ struct RoverParams {
   // External control: speeding up and braking, m/s^2.
   double max_acceleration_mps2 = 6.0;
   double max_deceleration_mps2 = 8.0;
+  // The tyres' grip: the path's curvature is held to this lateral
+  // acceleration over the speed squared (the car runs wide); 0: no limit.
+  double max_lateral_acceleration_mps2 = 0.0;
   // The body's footprint (for collisions): length, width, and how far its
   // back lies behind the rear axle, m.
   double length_m = 0.43;
