@@ -13,6 +13,7 @@
 
 #include "core/bus.h"
 #include "core/params.h"
+#include "logs/course_metrics.h"
 #include "logs/run_log.h"
 
 namespace nadir::terrain {
@@ -52,6 +53,8 @@ struct BatchReportInput {
   const logs::LogTrajectories& recorded;  // its truth and estimates, as evaluated
   std::string out_dir;                    // where the run's files go
   const terrain::World& world;
+  // Where a node puts a ground vehicle's course it scored (for metrics.json).
+  std::optional<logs::CourseMetrics>* course = nullptr;
 };
 
 struct EntryInfo {

@@ -2,6 +2,9 @@
 
 #include <array>
 #include <cmath>
+#include <map>
+#include <string>
+#include <tuple>
 
 #include <opencv2/imgproc.hpp>
 
@@ -87,6 +90,8 @@ CourseBoardRenderer::~CourseBoardRenderer() {
 void CourseBoardRenderer::setBoards(const std::vector<terrain::CourseBoard>& boards,
                                     const terrain::World& world) {
   boards_.clear();
+  // Boards of one pattern (the gates) share its drawing.
+  std::map<std::tuple<std::string, std::string, std::int64_t>, cv::Mat> patterns;
   for (const terrain::CourseBoard& board : boards) {
     auto gpu = std::make_unique<GpuBoard>();
     const double floor_up_m = world.groundUp_m(board.north_m, board.east_m);
@@ -145,8 +150,10 @@ void CourseBoardRenderer::setBoards(const std::vector<terrain::CourseBoard>& boa
                           reinterpret_cast<const void*>(5 * sizeof(float)));
     glEnableVertexAttribArray(2);
     glBindVertexArray(0);
-    cv::Mat rgb;
-    cv::cvtColor(terrain::boardPattern(board, kPatternPx), rgb, cv::COLOR_GRAY2RGB);
+    const bool decoy = board.kind == "decoy";
+    cv::Mat& rgb = patterns[{board.kind, decoy ? board.decoy_pattern : "",
+                             decoy ? board.seed : 0}];
+    if (rgb.empty()) cv::cvtColor(terrain::boardPattern(board, kPatternPx), rgb, cv::COLOR_GRAY2RGB);
     gpu->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_LINEAR);
     boards_.push_back(std::move(gpu));
   }

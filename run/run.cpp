@@ -164,11 +164,17 @@ RunResult runScenario(const RunOptions& options,
   result.table = eval::formatResultsTable(result.metrics);
   if (texture.result().frames > 0)
     result.table += "camera " + render::formatTexture(texture.result()) + "\n";
-  const nodes::BatchReportInput report_input{scenario, result.log_path, evaluation.recorded,
-                                             result.out_dir, *camera.scene().built.world};
+  std::optional<logs::CourseMetrics> course;
+  const nodes::BatchReportInput report_input{scenario,       result.log_path,
+                                             evaluation.recorded, result.out_dir,
+                                             *camera.scene().built.world, &course};
   for (const auto& [entry, params] : running_nodes) {
     const std::string section = entry->batchReport(report_input, params);
     if (!section.empty()) result.table += "\n" + section;
+  }
+  if (course) {
+    result.metrics.course = course;
+    eval::writeMetricsJson(result.metrics_path, result.metrics, eval::EvalOptions{});
   }
   return result;
 }

@@ -220,7 +220,7 @@ std::vector<CourseBoard> courseBoards(const CourseParams& params) {
 cv::Mat boardPattern(const CourseBoard& board, int size_px) {
   const PatternSpec spec = specOf(board);
   cv::Mat gray(size_px, size_px, CV_8UC1);
-  constexpr int kSamples = 4;
+  constexpr int kSamples = 3;
   for (int row = 0; row < size_px; ++row) {
     auto* out = gray.ptr<std::uint8_t>(row);
     for (int col = 0; col < size_px; ++col) {

@@ -2,12 +2,10 @@
 // results it adds to a batch run (gates passed, missed and hit, speeds, the
 // pipeline's time per frame and the camera-to-command latency).
 
-#include <filesystem>
 #include <sstream>
 
 #include "core/lcm_log.h"
 #include "lcmtypes/codec.h"
-#include "logs/eval/run_metrics.h"
 #include "nodes/control/control_node.h"
 #include "nodes/control/course_results.h"
 #include "nodes/ppa/ppa_node_params.h"
@@ -91,7 +89,7 @@ class ControlEntry final : public TypedEntry<ControlNodeParams> {
     return {{.channel = params.command_channel}};
   }
 
-  // The course scored from the truth (course.* in metrics.json).
+  // The course scored from the truth (course in metrics.json).
   std::string report(const BatchReportInput& input,
                      const ControlNodeParams& params) const override {
     control::CourseRunInput course;
@@ -106,13 +104,7 @@ class ControlEntry final : public TypedEntry<ControlNodeParams> {
     course.compute_s = params.compute_s;
     readPipeline(input.log_path, params.pattern_channel, params.command_channel, course);
     const logs::CourseMetrics metrics = control::courseResults(course);
-    const std::string path = (std::filesystem::path(input.out_dir) / "metrics.json").string();
-    if (std::filesystem::exists(path)) {
-      eval::EvalOptions options;
-      eval::RunMetrics run = eval::readMetricsJson(path, &options);
-      run.course = metrics;
-      eval::writeMetricsJson(path, run, options);
-    }
+    if (input.course != nullptr) *input.course = metrics;
     return control::formatCourse(metrics);
   }
 };
