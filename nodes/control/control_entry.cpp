@@ -2,6 +2,7 @@
 // results it adds to a batch run (gates passed, missed and hit, speeds, the
 // pipeline's time per frame and the camera-to-command latency).
 
+#include <filesystem>
 #include <sstream>
 
 #include "core/lcm_log.h"
@@ -50,7 +51,7 @@ void readPipeline(const std::string& log_path, const std::string& pattern_channe
                                 p.denoise_instructions, p.coordinates_instructions, p.chip_time_s});
       } else if (event->channel == command_channel) {
         const msg::DriveCommand c = msg::decode<msg::DriveCommand>(event->data);
-        input.commands.push_back({c.frame_utime, c.utime});
+        input.commands.push_back({c.frame_utime, c.utime, c.steer_rad});
       }
     } catch (const std::exception&) {
       // Not a message of the kind the channel should carry: not this run's pipeline.
@@ -105,7 +106,11 @@ class ControlEntry final : public TypedEntry<ControlNodeParams> {
     readPipeline(input.log_path, params.pattern_channel, params.command_channel, course);
     const logs::CourseMetrics metrics = control::courseResults(course);
     if (input.course != nullptr) *input.course = metrics;
-    return control::formatCourse(metrics);
+    const std::filesystem::path out(input.out_dir);
+    control::writeCoursePlots(course, metrics, (out / "course.png").string(),
+                              (out / "steering.png").string());
+    return control::formatCourse(metrics) + "pictures: " + (out / "course.png").string() + ", " +
+           (out / "steering.png").string() + "\n";
   }
 };
 

@@ -29,10 +29,11 @@ struct PatternFrame {
   double chip_time_s = 0.0;
 };
 
-// One command: the frame it came from and when it took effect.
+// One command: the frame it came from, when it took effect, and its steering.
 struct CommandTiming {
   std::int64_t frame_utime = 0;
   std::int64_t utime = 0;
+  double steer_rad = 0.0;
 };
 
 struct CourseRunInput {
@@ -63,5 +64,13 @@ struct FloorRectangle {
   double half_length_m = 0.0, half_width_m = 0.0;
 };
 bool overlap(const FloorRectangle& a, const FloorRectangle& b);
+
+// The pictures of a course run, as Liu et al.'s (2021) figures 13 and 14: the
+// path over the course (north to the right, coloured by speed, boards and
+// posts drawn to scale), and the steering angle against the distance to each
+// gate (or slalom board) as the rover approaches it. Throws std::runtime_error
+// when a file cannot be written.
+void writeCoursePlots(const CourseRunInput& input, const logs::CourseMetrics& metrics,
+                      const std::string& path_png, const std::string& steering_png);
 
 }  // namespace nadir::control

@@ -24,14 +24,15 @@ TEST(Registry, ListsEveryNodeOnceWithTheSimulatorLast) {
     EXPECT_EQ(entry->info().program.rfind("nadir-", 0), 0u) << entry->info().program;
   }
   EXPECT_EQ(names,
-            (std::set<std::string>{"sim", "camera", "ppa", "vo_feature", "vo_direct", "nav"}));
+            (std::set<std::string>{"sim", "camera", "ppa", "vo_feature", "vo_direct", "nav",
+                                   "control"}));
   EXPECT_EQ(registry().back()->info().role, EntryInfo::Role::kSimulator);
   EXPECT_EQ(&entry("ppa"), registry()[1].get());
   try {
     entry("vo_nothing");
     FAIL() << "an unknown node was found";
   } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("camera, ppa, vo_feature, vo_direct, nav, sim"),
+    EXPECT_NE(std::string(error.what()).find("camera, ppa, vo_feature, vo_direct, nav, control, sim"),
               std::string::npos)
         << error.what();
   }
@@ -46,15 +47,17 @@ TEST(Registry, ProcessingNodesHaveTheirScenarioGroup) {
     const bool processing = entry->info().role == EntryInfo::Role::kProcessing;
     EXPECT_EQ(entry->scenarioGroup().has_value(), processing) << entry->info().name;
   }
-  ASSERT_EQ(scenario.nodes.size(), 4u);
+  ASSERT_EQ(scenario.nodes.size(), 5u);
   EXPECT_EQ(scenario.nodes[0].name, "ppa");
   EXPECT_EQ(scenario.nodes[1].name, "vo_feature");
   EXPECT_EQ(scenario.nodes[2].name, "vo_direct");
   EXPECT_EQ(scenario.nodes[3].name, "nav");
+  EXPECT_EQ(scenario.nodes[4].name, "control");
   EXPECT_TRUE(entry("ppa").enabled(scenario));
   EXPECT_TRUE(entry("vo_feature").enabled(scenario));  // default.yaml enables both VOs
   EXPECT_TRUE(entry("vo_direct").enabled(scenario));
   EXPECT_TRUE(entry("nav").enabled(scenario));  // and the filter
+  EXPECT_FALSE(entry("control").enabled(scenario));  // no rover to steer
   bool renamed = false;
   for (const Stream& stream : entry("ppa").streams(entry("ppa").fromScenario(scenario))) {
     renamed = renamed || stream.channel == "MY_PPA";
