@@ -1,6 +1,7 @@
 #include "nodes/ppa/gate_tracker.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -159,9 +160,14 @@ GateResult GateTracker::processFrame(Ppa& ppa) {
   Program program(ppa);
   GateResult result;
   std::uint64_t mark = 0;
+  auto clock_mark = std::chrono::steady_clock::now();
+  std::size_t stage_index = 0;
   const auto stage = [&](std::uint64_t& into) {
     into += program.instructions() - mark;
     mark = program.instructions();
+    const auto now = std::chrono::steady_clock::now();
+    result.host_ns[stage_index++] = std::chrono::duration<double, std::nano>(now - clock_mark).count();
+    clock_mark = now;
   };
 
   binariseDark(program, kDark, params_.threshold);

@@ -82,6 +82,9 @@ struct GateResult {
   int patterns_in_view = 0;
   GateStageInstructions stages;
   std::uint64_t instructions = 0;
+  // What each stage took the emulator on the host, ns (threshold, flood,
+  // denoise, coordinates): wall-clock time, for benchmarks, never published.
+  std::array<double, 4> host_ns{};
 };
 
 class GateTracker {
