@@ -2,7 +2,8 @@
 # Renders the pictures in docs/images: with `nadir snapshot`, what the 1280x960
 # downward camera sees at 10, 50 and 300 m above ground over the procedural
 # world and over Zion National Park (SRTM DEM, Landsat 8 imagery at 30 m); with
-# nadir-viewer, the demo's run; with nadir-plot, the thesis's flight.
+# nadir-viewer, the demo's run; with nadir-plot, the thesis's flight; with nadir run,
+# the rover's gate course and slalom.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 nadir="$root/build/bin/nadir"
@@ -37,3 +38,11 @@ fi
 # The calibration window after the virtual checkerboard's 60 views.
 QT_QPA_PLATFORM=offscreen "$root/build/bin/nadir-calib" --virtual \
   --screenshot "$out/nadir_calib.png" >/dev/null
+
+# The closed loop: the rover's path through the gates and the slalom, and its
+# steering approaching each gate (the runs' course.png and steering.png).
+"$nadir" run gates --out "$root/out/pictures-gates" --force --no-images >/dev/null
+cp "$root/out/pictures-gates/course.png" "$out/gates_course.png"
+cp "$root/out/pictures-gates/steering.png" "$out/gates_steering.png"
+"$nadir" run slalom --out "$root/out/pictures-slalom" --force --no-images >/dev/null
+cp "$root/out/pictures-slalom/course.png" "$out/slalom_course.png"
