@@ -32,6 +32,7 @@
 #include "nadir/velocity_t.hpp"
 #include "nadir/vo_command_t.hpp"
 #include "nadir/vo_estimate_t.hpp"
+#include "nadir/waypoint_reached_t.hpp"
 
 namespace nadir::msg {
 namespace {
@@ -316,6 +317,10 @@ struct LcmOf<GatePattern> {
 template <>
 struct LcmOf<DriveCommand> {
   using type = nadir::drive_command_t;
+};
+template <>
+struct LcmOf<WaypointReached> {
+  using type = nadir::waypoint_reached_t;
 };
 template <>
 struct LcmOf<Heartbeat> {
@@ -876,6 +881,40 @@ Bytes encode(const DriveCommand& message) {
   return toBytes(out);
 }
 
+Bytes encode(const WaypointReached& message) {
+  nadir::waypoint_reached_t out{};
+  out.utime = message.utime;
+  out.index = message.index;
+  out.count = message.count;
+  put3(message.waypoint_ned_m, out.waypoint_ned);
+  put3(message.believed_ned_m, out.believed_ned);
+  put3(message.true_ned_m, out.true_ned);
+  out.source = message.source;
+  return toBytes(out);
+}
+
+template <>
+WaypointReached decode<WaypointReached>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::waypoint_reached_t>(data, size);
+  const std::string at = where(in);
+  requireFinite(in.waypoint_ned, 3, "waypoint_ned", at);
+  requireFinite(in.believed_ned, 3, "believed_ned", at);
+  requireFinite(in.true_ned, 3, "true_ned", at);
+  if (in.index < 0 || in.index >= in.count) {
+    throw InvalidMessage(at + ": index " + std::to_string(in.index) + " is not in [0, count " +
+                         std::to_string(in.count) + ")");
+  }
+  WaypointReached out;
+  out.utime = in.utime;
+  out.index = in.index;
+  out.count = in.count;
+  out.waypoint_ned_m = get3(in.waypoint_ned);
+  out.believed_ned_m = get3(in.believed_ned);
+  out.true_ned_m = get3(in.true_ned);
+  out.source = in.source;
+  return out;
+}
+
 template <>
 GatePattern decode<GatePattern>(const void* data, std::size_t size) {
   const auto in = fromBytes<nadir::gate_pattern_t>(data, size);
@@ -982,6 +1021,7 @@ NADIR_MSG_TYPE(TargetDetection)
 NADIR_MSG_TYPE(VoCommand)
 NADIR_MSG_TYPE(GatePattern)
 NADIR_MSG_TYPE(DriveCommand)
+NADIR_MSG_TYPE(WaypointReached)
 NADIR_MSG_TYPE(Heartbeat)
 #undef NADIR_MSG_TYPE
 
@@ -992,7 +1032,8 @@ std::string typeName(const void* data, std::size_t size) {
                  nadir::velocity_t, nadir::body_rates_t, nadir::camera_info_t,
                  nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t, nadir::nav_state_t,
                  nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
-                 nadir::gate_pattern_t, nadir::drive_command_t, nadir::heartbeat_t>();
+                 nadir::gate_pattern_t, nadir::drive_command_t, nadir::waypoint_reached_t,
+                 nadir::heartbeat_t>();
   const std::int64_t hash = fingerprintOf(data, size);
   for (const KnownType& type : kTypes) {
     if (type.hash == hash) return type.name;

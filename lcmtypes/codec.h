@@ -52,6 +52,7 @@ Bytes encode(const TargetDetection& message);
 Bytes encode(const VoCommand& message);
 Bytes encode(const GatePattern& message);
 Bytes encode(const DriveCommand& message);
+Bytes encode(const WaypointReached& message);
 Bytes encode(const Heartbeat& message);
 
 template <class T>

@@ -240,6 +240,17 @@ struct DriveCommand {
   double deformation = 0.0;
 };
 
+// waypoint_reached_t: the guidance took a waypoint as reached (world frame, m).
+struct WaypointReached {
+  std::int64_t utime = 0;
+  int index = 0;
+  int count = 0;
+  Eigen::Vector3d waypoint_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d believed_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d true_ned_m = Eigen::Vector3d::Zero();
+  std::string source;
+};
+
 // vo_command_t: a command to the VO nodes (target: a source name, or empty for all).
 struct VoCommand {
   enum class Kind { RESET };

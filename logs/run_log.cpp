@@ -57,6 +57,16 @@ bool TrajectoryCollector::add(const std::string& channel, const void* data, std:
     }
     return true;
   }
+  if (msg::isType<msg::WaypointReached>(data, size)) {
+    try {
+      const msg::WaypointReached w = msg::decode<msg::WaypointReached>(data, size);
+      waypoints_.push_back({core::stampFromUtime(w.utime), w.index, w.count, w.waypoint_ned_m,
+                            w.believed_ned_m, w.true_ned_m, w.source});
+    } catch (const std::exception&) {
+      ++undecodable_[channel];
+    }
+    return true;
+  }
   if (!msg::isType<msg::VoEstimate>(data, size)) return false;
   try {
     const msg::VoEstimate estimate = msg::decode<msg::VoEstimate>(data, size);
@@ -105,6 +115,9 @@ LogTrajectories TrajectoryCollector::trajectories() const {
     std::stable_sort(estimates.begin(), estimates.end(),
                      [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   }
+  out.waypoints = waypoints_;
+  std::stable_sort(out.waypoints.begin(), out.waypoints.end(),
+                   [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   out.filters = filters_;
   for (auto& [name, states] : out.filters) {
     std::stable_sort(states.begin(), states.end(),

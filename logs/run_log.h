@@ -47,11 +47,23 @@ struct FilterState {
   double last_gps_t_s = std::numeric_limits<double>::quiet_NaN();
 };
 
+// A waypoint the vehicle's guidance took as reached (waypoint_reached_t).
+struct WaypointPassage {
+  double t_s = 0.0;
+  int index = 0;
+  int count = 0;
+  Eigen::Vector3d waypoint_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d believed_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d true_ned_m = Eigen::Vector3d::Zero();
+  std::string source;  // what the guidance flew on
+};
+
 struct LogTrajectories {
   core::Trajectory truth;  // sorted by stamp, one pose per stamp
   std::string truth_channel;
   std::map<std::string, std::vector<SourceEstimate>> sources;  // by source name, sorted
   std::map<std::string, std::vector<FilterState>> filters;     // by source name, sorted
+  std::vector<WaypointPassage> waypoints;                       // in time order
   std::string damage;  // the reader's damage report and what was left out; empty if clean
 };
 
@@ -61,8 +73,8 @@ class TrajectoryCollector {
  public:
   // truth_channel: where the truth's pose_t is; empty: the channel carrying pose_t.
   explicit TrajectoryCollector(std::string truth_channel = {});
-  // Takes one message; false if it is neither truth, an estimate nor a filter
-  // state. A message of these types that does not decode, or holds a non-finite position or a
+  // Takes one message; false if it is neither truth, an estimate, a filter
+  // state nor a waypoint reached. A message of these types that does not decode, or holds a non-finite position or a
   // quaternion that is not a rotation, is counted and left out.
   bool add(const std::string& channel, const void* data, std::size_t size);
   std::size_t truthPoses() const;
@@ -73,6 +85,7 @@ class TrajectoryCollector {
  private:
   std::string truth_channel_;
   std::map<std::string, core::Trajectory> poses_;  // pose_t by channel
+  std::vector<WaypointPassage> waypoints_;
   std::map<std::string, std::vector<SourceEstimate>> sources_;
   std::map<std::string, std::vector<FilterState>> filters_;
   std::map<std::string, std::size_t> undecodable_;  // channel -> count

@@ -116,6 +116,7 @@ RunResult runScenario(const RunOptions& options,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
   sim::DriveCommandInput drive_commands(*bus, scenario.sim, simulator);
+  sim::GuidanceInput guidance(*bus, scenario.sim, simulator);
   std::vector<std::unique_ptr<nodes::Node>> running;
   for (const auto& [entry, params] : running_nodes) {
     if (entry->info().role == nodes::EntryInfo::Role::kProcessing) {

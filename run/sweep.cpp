@@ -250,6 +250,50 @@ bool anyCourse(const std::vector<SweepCell>& cells) {
                      [](const SweepCell& cell) { return cell.metrics && cell.metrics->course; });
 }
 
+bool anyGuidance(const std::vector<SweepCell>& cells) {
+  return std::any_of(cells.begin(), cells.end(), [](const SweepCell& cell) {
+    return cell.metrics && cell.metrics->guidance &&
+           cell.metrics->guidance->waypoints_on_source > 0;
+  });
+}
+
+constexpr const char* kGuidanceColumns[] = {"guidance.source", "guidance.waypoints_on_source",
+                                            "guidance.max_miss_m", "guidance.mean_miss_m",
+                                            "guidance.end_miss_m"};
+
+std::vector<std::string> guidanceCells(const eval::GuidanceMetrics& g) {
+  return {g.source, std::to_string(g.waypoints_on_source) + "/" + std::to_string(g.waypoints),
+          number(g.max_miss_m), number(g.mean_miss_m), number(g.end_miss_m)};
+}
+
+// Each cell's guidance: how far the truth was from where the vehicle believed.
+std::string guidanceMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
+  std::string md = "## Guidance: the truth against where the vehicle believed it was, at each "
+                   "waypoint reached on its source (m)\n\n|";
+  std::string rule = "|";
+  for (const SweepAxis& axis : spec.axes) {
+    md.append(" ").append(axis.key).append(" |");
+    rule += "---|";
+  }
+  for (const char* column : {"source", "waypoints on it", "max", "mean", "at the last"}) {
+    md.append(" ").append(column).append(" |");
+    rule += "---|";
+  }
+  md += "\n" + rule + "\n";
+  for (const SweepCell& cell : cells) {
+    md += "|";
+    for (const std::string& value : cell.values) md.append(" ").append(value).append(" |");
+    if (!cell.metrics || !cell.metrics->guidance) {
+      for (std::size_t i = 0; i < std::size(kGuidanceColumns); ++i) md += " - |";
+    } else {
+      for (const std::string& text : guidanceCells(*cell.metrics->guidance))
+        md.append(" ").append(text).append(" |");
+    }
+    md += "\n";
+  }
+  return md + "\n";
+}
+
 // A course's figures in sweep columns, in kCourseColumns' order.
 constexpr const char* kCourseColumns[] = {
     "course.gates_passed",  "course.gates_missed",      "course.gates_hit",
@@ -319,6 +363,7 @@ std::string courseMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& 
 std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
   const std::vector<std::string> sources = sourceNames(cells);
   const bool course = anyCourse(cells);
+  const bool guidance = anyGuidance(cells);
   std::string csv;
   for (const SweepAxis& axis : spec.axes) csv += axis.key + ",";
   csv += "run,truth_track_length_m";
@@ -340,6 +385,9 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
   }
   if (course) {
     for (const char* column : kCourseColumns) csv += std::string(",") + column;
+  }
+  if (guidance) {
+    for (const char* column : kGuidanceColumns) csv += std::string(",") + column;
   }
   csv += "\n";
   for (const SweepCell& cell : cells) {
@@ -372,6 +420,13 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
         csv += std::string(std::size(kCourseColumns), ',');
       }
     }
+    if (guidance) {
+      if (cell.metrics && cell.metrics->guidance) {
+        for (const std::string& text : guidanceCells(*cell.metrics->guidance)) csv += "," + text;
+      } else {
+        csv += std::string(std::size(kGuidanceColumns), ',');
+      }
+    }
     csv += "\n";
   }
   return csv;
@@ -382,6 +437,7 @@ std::string sweepMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& c
   const bool split = spec.axes.size() >= 3;
   const std::size_t first_row_axis = split ? 1 : 0;
   std::string md = "# Sweep: " + spec.scenario + "\n\n";
+  if (anyGuidance(cells)) md += guidanceMarkdown(spec, cells);
   if (anyCourse(cells)) {
     md += courseMarkdown(spec, cells);
     if (sources.empty()) return md;

@@ -149,6 +149,24 @@ Json courseJson(const logs::CourseMetrics& c) {
               {"stages", stages}};
 }
 
+Json guidanceJson(const GuidanceMetrics& g) {
+  Json passages = Json::array();
+  for (const GuidancePassage& p : g.passages) {
+    passages.push_back(Json{{"index", p.index},
+                            {"t_s", number(p.t_s)},
+                            {"source", p.source},
+                            {"miss_m", number(p.miss_m)},
+                            {"from_waypoint_m", number(p.from_waypoint_m)}});
+  }
+  return Json{{"source", g.source},
+              {"waypoints", g.waypoints},
+              {"waypoints_on_source", g.waypoints_on_source},
+              {"max_miss_m", number(g.max_miss_m)},
+              {"mean_miss_m", number(g.mean_miss_m)},
+              {"end_miss_m", number(g.end_miss_m)},
+              {"passages", passages}};
+}
+
 // Reading: every lookup names the key path and the file when it fails.
 class JsonReader {
  public:
@@ -260,6 +278,30 @@ SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::stri
   return m;
 }
 
+GuidanceMetrics guidanceFromJson(const JsonReader& r, const Json& j) {
+  const std::string where = "guidance";
+  GuidanceMetrics g;
+  g.source = r.text(j, "source", where);
+  g.waypoints = static_cast<int>(r.count(j, "waypoints", where));
+  g.waypoints_on_source = static_cast<int>(r.count(j, "waypoints_on_source", where));
+  g.max_miss_m = r.number(j, "max_miss_m", where);
+  g.mean_miss_m = r.number(j, "mean_miss_m", where);
+  g.end_miss_m = r.number(j, "end_miss_m", where);
+  const Json& passages = r.at(j, "passages", where);
+  if (!passages.is_array()) r.fail("guidance.passages", "is not an array");
+  for (const Json& p : passages) {
+    const std::string here = "guidance.passages";
+    GuidancePassage passage;
+    passage.index = static_cast<int>(r.count(p, "index", here));
+    passage.t_s = r.number(p, "t_s", here);
+    passage.source = r.text(p, "source", here);
+    passage.miss_m = r.number(p, "miss_m", here);
+    passage.from_waypoint_m = r.number(p, "from_waypoint_m", here);
+    g.passages.push_back(passage);
+  }
+  return g;
+}
+
 logs::CourseMetrics courseFromJson(const JsonReader& r, const Json& j) {
   const std::string where = "course";
   const auto integer = [&](const char* key) { return static_cast<int>(r.count(j, key, where)); };
@@ -321,6 +363,34 @@ std::string cell(double value, int decimals) {
 }
 
 }  // namespace
+
+GuidanceMetrics evaluateGuidance(const std::vector<logs::WaypointPassage>& waypoints,
+                                 double truth_start_s) {
+  GuidanceMetrics g;
+  double sum = 0.0, worst = 0.0;
+  for (const logs::WaypointPassage& w : waypoints) {
+    GuidancePassage p;
+    p.index = w.index;
+    p.t_s = w.t_s - truth_start_s;
+    p.source = w.source;
+    p.miss_m = (w.true_ned_m - w.believed_ned_m).norm();
+    p.from_waypoint_m = (w.true_ned_m - w.waypoint_ned_m).norm();
+    g.passages.push_back(p);
+    ++g.waypoints;
+    g.source = w.source;
+    if (w.source != "truth") {
+      ++g.waypoints_on_source;
+      sum += p.miss_m;
+      worst = std::max(worst, p.miss_m);
+    }
+  }
+  if (g.waypoints_on_source > 0) {
+    g.max_miss_m = worst;
+    g.mean_miss_m = sum / g.waypoints_on_source;
+  }
+  if (!g.passages.empty()) g.end_miss_m = g.passages.back().miss_m;
+  return g;
+}
 
 SourceMetrics evaluateSource(const core::Trajectory& truth,
                              const std::vector<SourceEstimate>& estimates,
@@ -470,6 +540,10 @@ RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out
   RunEvaluation run;
   run.recorded = logs::readRunLog(log_path, truth_channel);
   run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options, run.recorded.filters);
+  if (!run.recorded.waypoints.empty()) {
+    run.metrics.guidance = evaluateGuidance(
+        run.recorded.waypoints, run.recorded.truth.empty() ? 0.0 : run.recorded.truth.front().t_s);
+  }
   const std::filesystem::path dir(out_dir.empty() ? std::string(".") : out_dir);
   run.metrics_path = (dir / "metrics.json").string();
   writeMetricsJson(run.metrics_path, run.metrics, options);
@@ -504,6 +578,7 @@ void writeMetricsJson(const std::string& path, const RunMetrics& metrics,
   for (const auto& [name, source] : metrics.sources) sources[name] = sourceJson(source);
   j["sources"] = sources;
   if (metrics.course) j["course"] = courseJson(*metrics.course);
+  if (metrics.guidance) j["guidance"] = guidanceJson(*metrics.guidance);
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw EvalError(path + ": cannot open the file for writing");
   out << j.dump(2) << "\n";
@@ -548,6 +623,9 @@ RunMetrics readMetricsJson(const std::string& path, EvalOptions* options) {
   if (const auto it = j.find("course"); it != j.end() && !it->is_null()) {
     metrics.course = courseFromJson(r, *it);
   }
+  if (const auto it = j.find("guidance"); it != j.end() && !it->is_null()) {
+    metrics.guidance = guidanceFromJson(r, *it);
+  }
   return metrics;
 }
 
@@ -584,6 +662,21 @@ std::string formatResultsTable(const RunMetrics& metrics) {
                   cell(f.nees_position_mean, 2).c_str(), cell(f.nees_attitude_mean, 2).c_str(),
                   kNees3Low, kNees3High, cell(f.nees_position_in_band_pct, 1).c_str(),
                   cell(f.nees_attitude_in_band_pct, 1).c_str());
+    out += line;
+  }
+  if (metrics.guidance && metrics.guidance->waypoints > 0) {
+    const GuidanceMetrics& g = *metrics.guidance;
+    if (g.waypoints_on_source > 0) {
+      std::snprintf(line, sizeof line,
+                    "guidance on %s: %d of %d waypoints reached on it, the truth %s m from where "
+                    "it believed at most (%s m on average), %s m at the last\n",
+                    g.source.c_str(), g.waypoints_on_source, g.waypoints,
+                    cell(g.max_miss_m, 2).c_str(), cell(g.mean_miss_m, 2).c_str(),
+                    cell(g.end_miss_m, 2).c_str());
+    } else {
+      std::snprintf(line, sizeof line, "guidance on the truth: %d waypoints reached\n",
+                    g.waypoints);
+    }
     out += line;
   }
   if (metrics.sources.empty()) {

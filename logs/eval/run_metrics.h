@@ -54,6 +54,30 @@ struct SourceMetrics {
   std::optional<FilterMetrics> filter;
 };
 
+// The vehicle's guidance on a navigation source: how far the truth was from
+// where the guidance believed the vehicle was, each time it took a waypoint as
+// reached (docs/closed_loop.md).
+struct GuidancePassage {
+  int index = 0;
+  double t_s = kNaN;  // from the truth's start
+  std::string source;
+  double miss_m = kNaN;           // |true - believed|
+  double from_waypoint_m = kNaN;  // |true - waypoint| (a fixed-wing turns before it)
+};
+struct GuidanceMetrics {
+  std::string source;  // the source the guidance flew on last
+  int waypoints = 0;
+  int waypoints_on_source = 0;  // reached while flying on a source other than the truth
+  double max_miss_m = kNaN;     // over those
+  double mean_miss_m = kNaN;
+  double end_miss_m = kNaN;  // at the last waypoint
+  std::vector<GuidancePassage> passages;
+};
+
+// Throws nothing: no waypoints, no metrics (waypoints 0).
+GuidanceMetrics evaluateGuidance(const std::vector<logs::WaypointPassage>& waypoints,
+                                 double truth_start_s);
+
 struct RunMetrics {
   double truth_track_length_m = 0;
   double truth_duration_s = 0;
@@ -61,6 +85,8 @@ struct RunMetrics {
   std::map<std::string, SourceMetrics> sources;
   // A ground vehicle's course (gates, slalom boards), when the run had one.
   std::optional<logs::CourseMetrics> course;
+  // The guidance's waypoints, when the run reported any.
+  std::optional<GuidanceMetrics> guidance;
 };
 
 // One source against the truth (time-sorted, >= 2 poses, else EvalError).

@@ -91,6 +91,10 @@ struct NavNodeParams {
   // In a scenario: run the navigation filter (nadir run composes it, nadir
   // launch starts nadir-nav).
   bool enabled = false;
+  // Not the filter's: what the vehicle's guidance flies on from the GPS denial
+  // on (truth, gps, nav, vo_feature, vo_direct, ppa); the scenario hands it to
+  // the simulator (sim::GuidanceParams). The filter ignores it.
+  std::string source = "truth";
   std::string imu_channel = "IMU";
   std::string baro_channel = "BARO";
   std::string range_channel = "RANGE";

@@ -29,6 +29,7 @@ class SimLiveNode final : public Node {
                    sim::loadFlight(params.sim.flight, frame_, &flight_warning_)),
         publisher_(bus, params.sim, simulator_),
         commands_(bus, params.sim, simulator_),
+        guidance_(bus, params.sim, simulator_),
         utime_(simulator_.startUtime()),
         last_report_utime_(utime_) {}
 
@@ -64,6 +65,10 @@ class SimLiveNode final : public Node {
     for (const auto& [channel, count] : publisher_.counts()) {
       out << "; " << channel << " " << count;
     }
+    if (params_.sim.guidance.source != "truth") {
+      out << "; guidance on " << params_.sim.guidance.source << " (" << guidance_.fixes()
+          << " fixes)";
+    }
     if (simulator_.externalControl()) {
       out << "; drive commands " << commands_.received();
       if (commands_.dropped() > 0) out << " (" << commands_.dropped() << " invalid, dropped)";
@@ -92,6 +97,7 @@ class SimLiveNode final : public Node {
   sim::Simulator simulator_;
   sim::SimPublisher publisher_;
   sim::DriveCommandInput commands_;
+  sim::GuidanceInput guidance_;
   std::optional<std::chrono::steady_clock::time_point> wall_start_;
   std::int64_t utime_ = 0;
   std::int64_t last_report_utime_ = 0;

@@ -65,12 +65,40 @@ void SimPublisher::publish(const SimOutput& output) {
   if (output.gps) send(sensors.gps.channel, *output.gps);
   if (output.baro) send(sensors.barometer.channel, *output.baro);
   if (output.mag) send(sensors.magnetometer.channel, *output.mag);
+  if (output.waypoint) {
+    const WaypointEvent& w = *output.waypoint;
+    send(params_.guidance.waypoint_channel,
+         msg::WaypointReached{w.utime, w.index, w.count, w.waypoint_ned_m, w.believed_ned_m,
+                              w.true_ned_m, w.source});
+  }
   if (output.nav) {
     send(params_.truth.nav_position_channel, output.nav->position);
     send(params_.truth.nav_attitude_channel, output.nav->attitude);
     send(params_.truth.nav_velocity_channel, output.nav->velocity);
     send(params_.truth.nav_rates_channel, output.nav->rates);
   }
+}
+
+GuidanceInput::GuidanceInput(core::Bus& bus, const SimParams& params, Simulator& simulator)
+    : simulator_(simulator) {
+  const GuidanceParams& guidance = params.guidance;
+  if (guidance.source == "truth") return;
+  const std::string channel = guidance.estimateChannel();
+  if (guidance.source == "gps") {
+    subscription_ = msg::subscribe<msg::Gps>(bus, channel, [this](const msg::Gps& fix) {
+      if (fix.fix == msg::GpsFix::NONE) return;
+      ++fixes_;
+      simulator_.positionFix(fix.utime,
+                             simulator_.frame().nedFromGeodetic({fix.lat_rad, fix.lon_rad, fix.alt_m}));
+    });
+    return;
+  }
+  subscription_ =
+      msg::subscribe<msg::VoEstimate>(bus, channel, [this](const msg::VoEstimate& estimate) {
+        if (estimate.status != msg::VoStatus::TRACKING) return;
+        ++fixes_;
+        simulator_.positionFix(estimate.utime, estimate.p_ned_m);
+      });
 }
 
 DriveCommandInput::DriveCommandInput(core::Bus& bus, const SimParams& params, Simulator& simulator)

@@ -42,6 +42,20 @@ class SimPublisher {
   std::map<std::string, std::int64_t> counts_;
 };
 
+// A navigation source's positions for the guidance (guidance.source other
+// than truth): vo_estimate_t while TRACKING, or gps_t fixes, to
+// Simulator::positionFix.
+class GuidanceInput {
+ public:
+  GuidanceInput(core::Bus& bus, const SimParams& params, Simulator& simulator);
+  std::int64_t fixes() const { return fixes_; }
+
+ private:
+  Simulator& simulator_;
+  std::int64_t fixes_ = 0;
+  std::optional<core::Subscription> subscription_;
+};
+
 // Under external control, the drive commands on vehicle.command_channel go to
 // the simulator; commands that are not valid are dropped and counted.
 class DriveCommandInput {

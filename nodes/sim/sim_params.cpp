@@ -110,6 +110,29 @@ void SimNodeParams::visit(core::ParamVisitor& v) {
   sim.visit(v);
   core::visitGroup(v, "world", "the terrain and the world frame's origin", world);
   core::visitGroup(v, "time", "how sim time runs", time);
+  core::visitGroup(v, "guidance", "what the vehicle's guidance flies on (a scenario's nav.source)",
+                   sim.guidance);
+}
+
+void GuidanceParams::visit(core::ParamVisitor& v) {
+  v.field("source", &source,
+          {.doc = "what the guidance flies on after the GPS denial: truth, gps, nav, vo_feature, "
+                  "vo_direct or ppa",
+           .choices = {"truth", "gps", "nav", "vo_feature", "vo_direct", "ppa"}});
+  v.field("channel", &channel,
+          {.doc = "the estimate's channel; empty: the source's (GPS, POSE_NAV, POSE_VO_FEATURE, "
+                  "POSE_VO_DIRECT, POSE_PPA)"});
+  v.field("waypoint_channel", &waypoint_channel,
+          {.doc = "waypoint_reached_t out: each waypoint the guidance takes as reached"});
+}
+
+std::string GuidanceParams::estimateChannel() const {
+  if (!channel.empty() || source == "truth") return channel;
+  if (source == "gps") return "GPS";
+  if (source == "nav") return "POSE_NAV";
+  if (source == "vo_feature") return "POSE_VO_FEATURE";
+  if (source == "vo_direct") return "POSE_VO_DIRECT";
+  return "POSE_PPA";
 }
 
 }  // namespace nadir::sim

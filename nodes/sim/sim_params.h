@@ -126,6 +126,24 @@ struct SensorsParams {
   void visit(core::ParamVisitor& v);
 };
 
+// What the vehicle's guidance flies on: the truth, or a navigation source from
+// the GPS denial on (sensors.gps.denied_after_s; without a denial, from the
+// start). A scenario sets it as nav.source (docs/closed_loop.md).
+struct GuidanceParams {
+  // truth, gps (the GPS fixes, all along), nav (the navigation filter's
+  // POSE_NAV), vo_feature, vo_direct or ppa (their poses).
+  std::string source = "truth";
+  // The estimate's channel; empty: the source's (GPS, POSE_NAV,
+  // POSE_VO_FEATURE, POSE_VO_DIRECT, POSE_PPA).
+  std::string channel;
+  // waypoint_reached_t out: each waypoint the guidance takes as reached.
+  std::string waypoint_channel = "WAYPOINT";
+
+  void visit(core::ParamVisitor& v);
+  // The channel the estimate comes on.
+  std::string estimateChannel() const;
+};
+
 struct SimParams {
   // Stop after this much sim time, s; 0: when the route (or the flight) ends.
   double duration_s = 0.0;
@@ -135,8 +153,10 @@ struct SimParams {
   FlightParams flight;
   TruthParams truth;
   SensorsParams sensors;
+  // Not a scenario key of its own: a scenario's nav.source sets it.
+  GuidanceParams guidance;
 
-  // Visits the fields at the top level of a scenario.
+  // Visits the fields at the top level of a scenario (all but guidance).
   void visit(core::ParamVisitor& v);
 };
 
@@ -155,6 +175,7 @@ struct SimNodeParams {
   SimParams sim;
   terrain::WorldParams world;
   TimeParams time;
+  // sim.guidance, as the nadir-sim process reads it (group "guidance").
 
   void visit(core::ParamVisitor& v);
 };

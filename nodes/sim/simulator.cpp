@@ -205,6 +205,59 @@ void Simulator::applyCommands() {
   }
 }
 
+bool Simulator::guidanceOnSource(std::int64_t utime) const {
+  const std::string& source = params_.guidance.source;
+  if (source == "truth" || flight_ || external_) return false;
+  if (source == "gps") return true;
+  const double denied_s = params_.sensors.gps.model.denied_after_s;
+  return denied_s < 0.0 || core::secondsFromUtime(utime) >= denied_s;
+}
+
+std::string Simulator::guidanceSource() const {
+  return guidanceOnSource(utime_) ? params_.guidance.source : "truth";
+}
+
+void Simulator::setPositionError(const Eigen::Vector3d& error_m) {
+  position_error_m_ = error_m;
+  std::visit(
+      [&error_m](auto& vehicle) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {
+          vehicle.setPositionError(error_m);
+        }
+      },
+      vehicle_);
+}
+
+std::size_t Simulator::vehicleNextWaypoint() const {
+  return std::visit(
+      [](const auto& vehicle) -> std::size_t {
+        if constexpr (std::is_same_v<std::decay_t<decltype(vehicle)>, std::monostate>) {
+          return 0;
+        } else {
+          return vehicle.nextWaypoint();
+        }
+      },
+      vehicle_);
+}
+
+void Simulator::positionFix(std::int64_t utime, const Eigen::Vector3d& p_ned_m) {
+  if (!guidanceOnSource(utime) || recent_truth_.empty() || !p_ned_m.allFinite()) return;
+  if (utime < recent_truth_.front().first || utime > recent_truth_.back().first) return;
+  const auto after = std::lower_bound(
+      recent_truth_.begin(), recent_truth_.end(), utime,
+      [](const std::pair<std::int64_t, Eigen::Vector3d>& sample, std::int64_t t) {
+        return sample.first < t;
+      });
+  Eigen::Vector3d p_true = after->second;
+  if (after != recent_truth_.begin() && after->first != utime) {
+    const auto before = after - 1;
+    const double share = static_cast<double>(utime - before->first) /
+                         static_cast<double>(after->first - before->first);
+    p_true = before->second + share * (after->second - before->second);
+  }
+  setPositionError(p_ned_m - p_true);
+}
+
 bool Simulator::finished() const {
   if (!started_) return false;
   if (external_ && rover_moved_ && rover_still_since_ >= 0 &&
@@ -219,6 +272,7 @@ bool Simulator::finished() const {
 }
 
 SimOutput Simulator::step() {
+  const std::size_t heading_for = vehicleNextWaypoint();
   if (started_) {
     utime_ += step_us_;
     if (external_) applyCommands();
@@ -234,6 +288,22 @@ SimOutput Simulator::step() {
   SimOutput out;
   out.truth = currentState();
   out.truth.utime = utime_;
+  if (!flight_) {
+    recent_truth_.emplace_back(utime_, out.truth.p_ned_m);
+    while (recent_truth_.front().first < utime_ - 5'000'000) recent_truth_.pop_front();
+    const std::size_t now_heading_for = vehicleNextWaypoint();
+    if (!external_ && now_heading_for > heading_for && heading_for < route_.waypoints.size()) {
+      WaypointEvent event;
+      event.utime = utime_;
+      event.index = static_cast<int>(heading_for);
+      event.count = static_cast<int>(route_.waypoints.size());
+      event.waypoint_ned_m = route_.waypoints[heading_for].p_ned_m;
+      event.true_ned_m = out.truth.p_ned_m;
+      event.believed_ned_m = out.truth.p_ned_m + position_error_m_;
+      event.source = guidanceSource();
+      out.waypoint = event;
+    }
+  }
   const std::int64_t t = utime_;
   if (imu_ && core::due(t, params_.sensors.imu.model.rate_hz, imu_due_)) {
     out.imu = imu_->sample(out.truth);

@@ -4,7 +4,9 @@
 // own fixed grids. Plain structs out; the node or the batch runner turns them
 // into messages. Deterministic: the same params and seeds give the same outputs.
 
+#include <deque>
 #include <memory>
+#include <string>
 #include <optional>
 #include <variant>
 #include <vector>
@@ -43,6 +45,17 @@ struct DriveInput {
   double speed_mps = 0.0;
 };
 
+// The guidance took a waypoint as reached (world frame, m).
+struct WaypointEvent {
+  std::int64_t utime = 0;
+  int index = 0;
+  int count = 0;
+  Eigen::Vector3d waypoint_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d believed_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d true_ned_m = Eigen::Vector3d::Zero();
+  std::string source;  // what the guidance flew on then
+};
+
 // One simulation step: the true state and the sensor samples that fell due.
 struct SimOutput {
   VehicleState truth;
@@ -54,6 +67,8 @@ struct SimOutput {
   // The NAV_* messages, when due (at truth.nav_rate_hz): the flight
   // controller's estimate (sensors.ahrs), or the truth with ideal.
   std::optional<NavMessages> nav;
+  // A waypoint the guidance took as reached in this step.
+  std::optional<WaypointEvent> waypoint;
 };
 
 class Simulator {
@@ -79,6 +94,14 @@ class Simulator {
   void drive(const DriveInput& command);
   bool externalControl() const { return external_; }
 
+  // A navigation source's position at utime (guidance.source other than
+  // truth): from the GPS denial on (gps: all along) the guidance flies on it,
+  // its error against the truth at its time held until the next. A fix older
+  // than the truth kept (5 s) or newer than now is ignored.
+  void positionFix(std::int64_t utime, const Eigen::Vector3d& p_ned_m);
+  // What the guidance flies on now.
+  std::string guidanceSource() const;
+
   std::int64_t startUtime() const { return start_utime_; }
   // Ellipsoid altitude of the start, m: the zero of the NAV relative altitude.
   double startAltitude_m() const { return start_altitude_m_; }
@@ -102,6 +125,14 @@ class Simulator {
   std::vector<DriveInput> pending_commands_;
   std::optional<DriveInput> applied_command_;
   bool rover_moved_ = false;
+  // The truth's recent positions (for a fix's error at its time) and the
+  // waypoint the guidance heads for.
+  std::deque<std::pair<std::int64_t, Eigen::Vector3d>> recent_truth_;
+  std::size_t next_waypoint_ = 0;
+  Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
+  void setPositionError(const Eigen::Vector3d& error_m);
+  std::size_t vehicleNextWaypoint() const;
+  bool guidanceOnSource(std::int64_t utime) const;
   std::int64_t rover_still_since_ = -1;
   void applyCommands();
   std::int64_t step_us_ = 0;

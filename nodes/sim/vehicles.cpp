@@ -154,7 +154,8 @@ void FixedWing::step() {
       std::clamp(legSpeed_mps(next_waypoint_) - airspeed_mps_, -max_speed_step, max_speed_step);
   const double airspeed = airspeed_mps_;
   const double max_bank = params_.max_bank_deg * kDeg;
-  const Eigen::Vector3d p = state_.p_ned_m;
+  // The guidance flies on where it believes the aircraft is.
+  const Eigen::Vector3d p = state_.p_ned_m + position_error_m_;
 
   // Waypoint switching, with turn anticipation: start the turn where an arc at
   // the maximum bank joins the next leg.
@@ -229,7 +230,7 @@ void FixedWing::step() {
   const Eigen::Vector3d velocity = air_velocity + wind + gust_ned_mps_;
   state_.a_ned_mps2 = (velocity - state_.v_ned_mps) / dt;
   state_.v_ned_mps = velocity;
-  state_.p_ned_m = p + velocity * dt;
+  state_.p_ned_m += velocity * dt;
   const core::RollPitchYaw rpy{bank_rad_, gamma, heading_rad_};
   state_.q_world_body = core::quaternionFromRpy(rpy);
   state_.omega_body_rps =
@@ -269,7 +270,8 @@ void Multirotor::step() {
   double yaw_rate_rps = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   if (!finished()) {
-    const Eigen::Vector3d to_target = waypoints_[next_waypoint_].p_ned_m - state_.p_ned_m;
+    const Eigen::Vector3d to_target =
+        waypoints_[next_waypoint_].p_ned_m - (state_.p_ned_m + position_error_m_);
     const double distance_m = to_target.norm();
     const double leg_course = std::atan2(to_target.y(), to_target.x());
     const double yaw_error = core::wrapAngle_rad(leg_course - yaw_rad_);
@@ -381,16 +383,16 @@ void Rover::step() {
     speed_mps_ +=
         std::clamp(change, -params_.max_deceleration_mps2 * dt, params_.max_acceleration_mps2 * dt);
     speed = speed_mps_;
-  } else if (!finished() &&
-             (horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m)).norm() <=
-                 params_.arrival_radius_m) {
+  } else if (!finished() && (horizontal(waypoints_[next_waypoint_].p_ned_m) -
+                              horizontal(state_.p_ned_m + position_error_m_))
+                                     .norm() <= params_.arrival_radius_m) {
     ++next_waypoint_;
   }
   if (!external_ && !finished()) {
     speed = speedOf(waypoints_, next_waypoint_, params_.speed_mps);
     // Pure pursuit: the arc through the goal point ahead, curvature 2 sin(alpha) / L.
-    const Eigen::Vector2d to_goal =
-        horizontal(waypoints_[next_waypoint_].p_ned_m) - horizontal(state_.p_ned_m);
+    const Eigen::Vector2d to_goal = horizontal(waypoints_[next_waypoint_].p_ned_m) -
+                                    horizontal(state_.p_ned_m + position_error_m_);
     const double alpha = core::wrapAngle_rad(std::atan2(to_goal.y(), to_goal.x()) - heading_rad_);
     const double distance = std::max(std::min(to_goal.norm(), params_.lookahead_m), 1e-6);
     // A goal behind gets the tightest turn towards it, not none.

@@ -63,6 +63,13 @@ class FixedWing {
   // Advances one step of params.step_s.
   void step();
   const VehicleState& state() const { return state_; }
+  // Where the guidance believes the vehicle is, less where it is: the guidance
+  // flies on the true position plus this (a navigation source's error).
+  void setPositionError(const Eigen::Vector3d& believed_minus_true_m) {
+    position_error_m_ = believed_minus_true_m;
+  }
+  const Eigen::Vector3d& positionError() const { return position_error_m_; }
+  const std::vector<Waypoint>& waypoints() const { return waypoints_; }
   // True once the last waypoint has been passed.
   bool finished() const { return next_waypoint_ >= waypoints_.size(); }
   double bank_rad() const { return bank_rad_; }
@@ -85,6 +92,7 @@ class FixedWing {
   double bank_rad_ = 0.0;
   double airspeed_mps_ = 0.0;
   double climb_rate_mps_ = 0.0;
+  Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d gust_ned_mps_ = Eigen::Vector3d::Zero();
   GaussianNoise noise_;
 };
@@ -116,11 +124,19 @@ class Multirotor {
       : Multirotor(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
   void step();
   const VehicleState& state() const { return state_; }
+  // As FixedWing::setPositionError.
+  void setPositionError(const Eigen::Vector3d& believed_minus_true_m) {
+    position_error_m_ = believed_minus_true_m;
+  }
+  const Eigen::Vector3d& positionError() const { return position_error_m_; }
+  const std::vector<Waypoint>& waypoints() const { return waypoints_; }
   bool finished() const { return next_waypoint_ >= waypoints_.size(); }
+  std::size_t nextWaypoint() const { return next_waypoint_; }
   double yaw_rad() const { return yaw_rad_; }
 
  private:
   MultirotorParams params_;
+  Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
   std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   VehicleState state_;
@@ -174,6 +190,13 @@ class Rover {
   void command(double steer_rad, double speed_mps);
   void step();
   const VehicleState& state() const { return state_; }
+  // As FixedWing::setPositionError (for following waypoints).
+  void setPositionError(const Eigen::Vector3d& believed_minus_true_m) {
+    position_error_m_ = believed_minus_true_m;
+  }
+  const Eigen::Vector3d& positionError() const { return position_error_m_; }
+  const std::vector<Waypoint>& waypoints() const { return waypoints_; }
+  std::size_t nextWaypoint() const { return next_waypoint_; }
   // Following waypoints: the last one passed; under external control, never.
   bool finished() const { return !external_ && next_waypoint_ >= waypoints_.size(); }
   double steer_rad() const { return steer_rad_; }
@@ -183,6 +206,7 @@ class Rover {
  private:
   RoverParams params_;
   bool external_ = false;
+  Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
   double steer_command_rad_ = 0.0;
   double speed_command_mps_ = 0.0;
   double speed_mps_ = 0.0;

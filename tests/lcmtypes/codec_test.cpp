@@ -567,5 +567,32 @@ TEST(Codec, DriveCommandRoundTripAndRefusals) {
   refused(bad, "mode");
 }
 
+// A waypoint reached comes back whole; an index outside the route is refused.
+TEST(Codec, WaypointReachedRoundTripAndRefusal) {
+  WaypointReached w;
+  w.utime = 52'475'000;
+  w.index = 5;
+  w.count = 13;
+  w.waypoint_ned_m = {100.0, -20.0, -300.0};
+  w.believed_ned_m = {99.0, -21.0, -300.5};
+  w.true_ned_m = {98.0, -22.0, -301.0};
+  w.source = "nav";
+  const WaypointReached back = decode<WaypointReached>(encode(w));
+  EXPECT_EQ(back.utime, w.utime);
+  EXPECT_EQ(back.index, 5);
+  EXPECT_EQ(back.count, 13);
+  EXPECT_EQ(back.waypoint_ned_m, w.waypoint_ned_m);
+  EXPECT_EQ(back.believed_ned_m, w.believed_ned_m);
+  EXPECT_EQ(back.true_ned_m, w.true_ned_m);
+  EXPECT_EQ(back.source, "nav");
+  w.index = 13;
+  try {
+    decode<WaypointReached>(encode(w));
+    FAIL() << "an index past the route was accepted";
+  } catch (const InvalidMessage& error) {
+    EXPECT_NE(std::string(error.what()).find("index 13"), std::string::npos) << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace nadir::msg

@@ -331,6 +331,70 @@ TEST(EvalMetricsJson, FilterFiguresRoundTrip) {
       << table;
 }
 
+// The guidance's waypoints: the truth against where the vehicle believed it
+// was, worked by hand (a 3-4-5 miss, then 0 and 12 m), over the waypoints
+// reached on the source only; and the figures and a course through metrics.json.
+TEST(EvalMetricsJson, GuidanceAndCourseRoundTrip) {
+  const auto passage = [](double t, int index, const char* source, Eigen::Vector3d truth,
+                          Eigen::Vector3d believed) {
+    logs::WaypointPassage w;
+    w.t_s = t;
+    w.index = index;
+    w.count = 3;
+    w.waypoint_ned_m = believed;
+    w.believed_ned_m = believed;
+    w.true_ned_m = truth;
+    w.source = source;
+    return w;
+  };
+  const GuidanceMetrics guidance = evaluateGuidance(
+      {passage(110.0, 0, "truth", {1.0, 2.0, 0.0}, {1.0, 2.0, 0.0}),
+       passage(130.0, 1, "nav", {103.0, 4.0, 0.0}, {100.0, 0.0, 0.0}),
+       passage(150.0, 2, "nav", {200.0, 12.0, 0.0}, {200.0, 0.0, 0.0})},
+      100.0);
+  EXPECT_EQ(guidance.waypoints, 3);
+  EXPECT_EQ(guidance.waypoints_on_source, 2);
+  EXPECT_EQ(guidance.source, "nav");
+  EXPECT_DOUBLE_EQ(guidance.passages[1].miss_m, 5.0);
+  EXPECT_DOUBLE_EQ(guidance.passages[1].t_s, 30.0);
+  EXPECT_DOUBLE_EQ(guidance.max_miss_m, 12.0);
+  EXPECT_DOUBLE_EQ(guidance.mean_miss_m, 8.5);
+  EXPECT_DOUBLE_EQ(guidance.end_miss_m, 12.0);
+
+  RunMetrics written;
+  written.truth_poses = 10;
+  written.guidance = guidance;
+  logs::CourseMetrics course;
+  course.gates = 8;
+  course.gates_passed = 7;
+  course.gates_hit = 1;
+  course.average_speed_mps = 2.3;
+  course.passages.push_back({"gate", true, true, false, 1.5, 0.02, -3.0});
+  course.stages.push_back({"de-noising", 10.0, 1.0, 4.0});
+  written.course = course;
+  const std::string path = tempPath("guidance_metrics.json");
+  writeMetricsJson(path, written, EvalOptions{});
+  const RunMetrics read = readMetricsJson(path);
+  ASSERT_TRUE(read.guidance.has_value());
+  EXPECT_EQ(read.guidance->waypoints_on_source, 2);
+  EXPECT_DOUBLE_EQ(read.guidance->max_miss_m, 12.0);
+  ASSERT_EQ(read.guidance->passages.size(), 3u);
+  EXPECT_EQ(read.guidance->passages[2].source, "nav");
+  ASSERT_TRUE(read.course.has_value());
+  EXPECT_EQ(read.course->gates_passed, 7);
+  EXPECT_EQ(read.course->gates_hit, 1);
+  EXPECT_DOUBLE_EQ(read.course->average_speed_mps, 2.3);
+  EXPECT_TRUE(std::isnan(read.course->peak_speed_mps));
+  ASSERT_EQ(read.course->passages.size(), 1u);
+  EXPECT_DOUBLE_EQ(read.course->passages[0].offset_m, 0.02);
+  EXPECT_EQ(read.course->stages[0].name, "de-noising");
+  const std::string table = formatResultsTable(read);
+  EXPECT_NE(table.find("guidance on nav: 2 of 3 waypoints reached on it, the truth 12.00 m from "
+                       "where it believed at most (8.50 m on average), 12.00 m at the last"),
+            std::string::npos)
+      << table;
+}
+
 // A damaged metrics.json is refused with the file and the key.
 TEST(EvalMetricsJson, MissingKeyIsNamed) {
   const std::string path = tempPath("bad_metrics.json");
