@@ -63,7 +63,7 @@ struct LogTrajectories {
   std::string truth_channel;
   std::map<std::string, std::vector<SourceEstimate>> sources;  // by source name, sorted
   std::map<std::string, std::vector<FilterState>> filters;     // by source name, sorted
-  std::vector<WaypointPassage> waypoints;                       // in time order
+  std::vector<WaypointPassage> waypoints;                      // in time order
   std::string damage;  // the reader's damage report and what was left out; empty if clean
 };
 
@@ -74,8 +74,8 @@ class TrajectoryCollector {
   // truth_channel: where the truth's pose_t is; empty: the channel carrying pose_t.
   explicit TrajectoryCollector(std::string truth_channel = {});
   // Takes one message; false if it is neither truth, an estimate, a filter
-  // state nor a waypoint reached. A message of these types that does not decode, or holds a non-finite position or a
-  // quaternion that is not a rotation, is counted and left out.
+  // state nor a waypoint reached. A message of these types that does not decode, or holds a
+  // non-finite position or a quaternion that is not a rotation, is counted and left out.
   bool add(const std::string& channel, const void* data, std::size_t size);
   std::size_t truthPoses() const;
   // What was gathered so far. Throws RunLogError when pose_t came on several

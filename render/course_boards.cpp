@@ -151,9 +151,9 @@ void CourseBoardRenderer::setBoards(const std::vector<terrain::CourseBoard>& boa
     glEnableVertexAttribArray(2);
     glBindVertexArray(0);
     const bool decoy = board.kind == "decoy";
-    cv::Mat& rgb = patterns[{board.kind, decoy ? board.decoy_pattern : "",
-                             decoy ? board.seed : 0}];
-    if (rgb.empty()) cv::cvtColor(terrain::boardPattern(board, kPatternPx), rgb, cv::COLOR_GRAY2RGB);
+    cv::Mat& rgb = patterns[{board.kind, decoy ? board.decoy_pattern : "", decoy ? board.seed : 0}];
+    if (rgb.empty())
+      cv::cvtColor(terrain::boardPattern(board, kPatternPx), rgb, cv::COLOR_GRAY2RGB);
     gpu->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_LINEAR);
     boards_.push_back(std::move(gpu));
   }

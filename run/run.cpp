@@ -166,9 +166,9 @@ RunResult runScenario(const RunOptions& options,
   if (texture.result().frames > 0)
     result.table += "camera " + render::formatTexture(texture.result()) + "\n";
   std::optional<logs::CourseMetrics> course;
-  const nodes::BatchReportInput report_input{scenario,       result.log_path,
-                                             evaluation.recorded, result.out_dir,
-                                             *camera.scene().built.world, &course};
+  const nodes::BatchReportInput report_input{
+      scenario, result.log_path, evaluation.recorded, result.out_dir, *camera.scene().built.world,
+      &course};
   for (const auto& [entry, params] : running_nodes) {
     const std::string section = entry->batchReport(report_input, params);
     if (!section.empty()) result.table += "\n" + section;

@@ -268,8 +268,9 @@ std::vector<std::string> guidanceCells(const eval::GuidanceMetrics& g) {
 
 // Each cell's guidance: how far the truth was from where the vehicle believed.
 std::string guidanceMarkdown(const SweepSpec& spec, const std::vector<SweepCell>& cells) {
-  std::string md = "## Guidance: the truth against where the vehicle believed it was, at each "
-                   "waypoint reached on its source (m)\n\n|";
+  std::string md =
+      "## Guidance: the truth against where the vehicle believed it was, at each "
+      "waypoint reached on its source (m)\n\n|";
   std::string rule = "|";
   for (const SweepAxis& axis : spec.axes) {
     md.append(" ").append(axis.key).append(" |");

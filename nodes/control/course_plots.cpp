@@ -96,7 +96,8 @@ void writeCoursePlots(const CourseRunInput& input, const logs::CourseMetrics& me
       const Eigen::Vector2d f(std::cos(h), std::sin(h)), r(-std::sin(h), std::cos(h));
       std::vector<cv::Point> square;
       for (const auto& [a, b] : {std::pair{-1, -1}, {-1, 1}, {1, 1}, {1, -1}}) {
-        const Eigen::Vector2d c = Eigen::Vector2d(post.north_m, post.east_m) + a * s * f + b * s * r;
+        const Eigen::Vector2d c =
+            Eigen::Vector2d(post.north_m, post.east_m) + a * s * f + b * s * r;
         square.push_back(toPoint(pixel(c.x(), c.y())));
       }
       cv::fillConvexPoly(image, square, colour, cv::LINE_AA);
@@ -128,7 +129,7 @@ void writeCoursePlots(const CourseRunInput& input, const logs::CourseMetrics& me
                 metrics.average_speed_mps);
   text(image, title, {kMargin, 30}, 0.55);
   text(image, "north to the right, east down; posts and boards to scale, decoys grey",
-           {kMargin, 52}, 0.45, kGrey);
+       {kMargin, 52}, 0.45, kGrey);
   // 1 m scale bar.
   cv::line(image, {kMargin, height - 20}, {kMargin + static_cast<int>(scale), height - 20}, kBlack,
            2);
@@ -139,7 +140,8 @@ void writeCoursePlots(const CourseRunInput& input, const logs::CourseMetrics& me
   constexpr int kW = 900, kH = 520, kLeft = 70, kRight = 20, kPlotTop = 50, kBottom = 50;
   constexpr double kMaxDistance_m = 3.0;
   double lock_deg = 5.0;
-  for (const CommandTiming& c : input.commands) lock_deg = std::max(lock_deg, std::abs(c.steer_rad) / kDeg);
+  for (const CommandTiming& c : input.commands)
+    lock_deg = std::max(lock_deg, std::abs(c.steer_rad) / kDeg);
   lock_deg = std::ceil(lock_deg / 5.0) * 5.0;
   cv::Mat plot(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255));
   const auto at = [&](double distance_m, double steer_deg) {

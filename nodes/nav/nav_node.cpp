@@ -93,10 +93,11 @@ void NavInitialSigmas::visit(core::ParamVisitor& v) {
 
 void NavNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the navigation filter in this scenario"});
-  v.field("source", &source,
-          {.doc = "what the vehicle's guidance flies on after the GPS denial: truth, gps, nav (this "
-                  "filter), vo_feature, vo_direct or ppa",
-           .choices = {"truth", "gps", "nav", "vo_feature", "vo_direct", "ppa"}});
+  v.field(
+      "source", &source,
+      {.doc = "what the vehicle's guidance flies on after the GPS denial: truth, gps, nav (this "
+              "filter), vo_feature, vo_direct or ppa",
+       .choices = {"truth", "gps", "nav", "vo_feature", "vo_direct", "ppa"}});
   v.field("imu_channel", &imu_channel, {.doc = "imu_t in: drives the filter"});
   v.field("baro_channel", &baro_channel, {.doc = "baro_t in"});
   v.field("range_channel", &range_channel, {.doc = "range_t in"});

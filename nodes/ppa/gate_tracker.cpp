@@ -166,7 +166,8 @@ GateResult GateTracker::processFrame(Ppa& ppa) {
     into += program.instructions() - mark;
     mark = program.instructions();
     const auto now = std::chrono::steady_clock::now();
-    result.host_ns[stage_index++] = std::chrono::duration<double, std::nano>(now - clock_mark).count();
+    result.host_ns[stage_index++] =
+        std::chrono::duration<double, std::nano>(now - clock_mark).count();
     clock_mark = now;
   };
 

@@ -88,8 +88,8 @@ GuidanceInput::GuidanceInput(core::Bus& bus, const SimParams& params, Simulator&
     subscription_ = msg::subscribe<msg::Gps>(bus, channel, [this](const msg::Gps& fix) {
       if (fix.fix == msg::GpsFix::NONE) return;
       ++fixes_;
-      simulator_.positionFix(fix.utime,
-                             simulator_.frame().nedFromGeodetic({fix.lat_rad, fix.lon_rad, fix.alt_m}));
+      simulator_.positionFix(
+          fix.utime, simulator_.frame().nedFromGeodetic({fix.lat_rad, fix.lon_rad, fix.alt_m}));
     });
     return;
   }

@@ -243,11 +243,9 @@ std::size_t Simulator::vehicleNextWaypoint() const {
 void Simulator::positionFix(std::int64_t utime, const Eigen::Vector3d& p_ned_m) {
   if (!guidanceOnSource(utime) || recent_truth_.empty() || !p_ned_m.allFinite()) return;
   if (utime < recent_truth_.front().first || utime > recent_truth_.back().first) return;
-  const auto after = std::lower_bound(
-      recent_truth_.begin(), recent_truth_.end(), utime,
-      [](const std::pair<std::int64_t, Eigen::Vector3d>& sample, std::int64_t t) {
-        return sample.first < t;
-      });
+  const auto after = std::lower_bound(recent_truth_.begin(), recent_truth_.end(), utime,
+                                      [](const std::pair<std::int64_t, Eigen::Vector3d>& sample,
+                                         std::int64_t t) { return sample.first < t; });
   Eigen::Vector3d p_true = after->second;
   if (after != recent_truth_.begin() && after->first != utime) {
     const auto before = after - 1;

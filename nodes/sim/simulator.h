@@ -6,8 +6,8 @@
 
 #include <deque>
 #include <memory>
-#include <string>
 #include <optional>
+#include <string>
 #include <variant>
 #include <vector>
 

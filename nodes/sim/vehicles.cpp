@@ -384,8 +384,8 @@ void Rover::step() {
         std::clamp(change, -params_.max_deceleration_mps2 * dt, params_.max_acceleration_mps2 * dt);
     speed = speed_mps_;
   } else if (!finished() && (horizontal(waypoints_[next_waypoint_].p_ned_m) -
-                              horizontal(state_.p_ned_m + position_error_m_))
-                                     .norm() <= params_.arrival_radius_m) {
+                             horizontal(state_.p_ned_m + position_error_m_))
+                                    .norm() <= params_.arrival_radius_m) {
     ++next_waypoint_;
   }
   if (!external_ && !finished()) {

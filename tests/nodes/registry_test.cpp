@@ -23,17 +23,17 @@ TEST(Registry, ListsEveryNodeOnceWithTheSimulatorLast) {
     EXPECT_TRUE(programs.insert(entry->info().program).second) << entry->info().program;
     EXPECT_EQ(entry->info().program.rfind("nadir-", 0), 0u) << entry->info().program;
   }
-  EXPECT_EQ(names,
-            (std::set<std::string>{"sim", "camera", "ppa", "vo_feature", "vo_direct", "nav",
-                                   "control"}));
+  EXPECT_EQ(names, (std::set<std::string>{"sim", "camera", "ppa", "vo_feature", "vo_direct", "nav",
+                                          "control"}));
   EXPECT_EQ(registry().back()->info().role, EntryInfo::Role::kSimulator);
   EXPECT_EQ(&entry("ppa"), registry()[1].get());
   try {
     entry("vo_nothing");
     FAIL() << "an unknown node was found";
   } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("camera, ppa, vo_feature, vo_direct, nav, control, sim"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(error.what()).find("camera, ppa, vo_feature, vo_direct, nav, control, sim"),
+        std::string::npos)
         << error.what();
   }
 }
@@ -56,7 +56,7 @@ TEST(Registry, ProcessingNodesHaveTheirScenarioGroup) {
   EXPECT_TRUE(entry("ppa").enabled(scenario));
   EXPECT_TRUE(entry("vo_feature").enabled(scenario));  // default.yaml enables both VOs
   EXPECT_TRUE(entry("vo_direct").enabled(scenario));
-  EXPECT_TRUE(entry("nav").enabled(scenario));  // and the filter
+  EXPECT_TRUE(entry("nav").enabled(scenario));       // and the filter
   EXPECT_FALSE(entry("control").enabled(scenario));  // no rover to steer
   bool renamed = false;
   for (const Stream& stream : entry("ppa").streams(entry("ppa").fromScenario(scenario))) {

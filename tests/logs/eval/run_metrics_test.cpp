@@ -347,11 +347,11 @@ TEST(EvalMetricsJson, GuidanceAndCourseRoundTrip) {
     w.source = source;
     return w;
   };
-  const GuidanceMetrics guidance = evaluateGuidance(
-      {passage(110.0, 0, "truth", {1.0, 2.0, 0.0}, {1.0, 2.0, 0.0}),
-       passage(130.0, 1, "nav", {103.0, 4.0, 0.0}, {100.0, 0.0, 0.0}),
-       passage(150.0, 2, "nav", {200.0, 12.0, 0.0}, {200.0, 0.0, 0.0})},
-      100.0);
+  const GuidanceMetrics guidance =
+      evaluateGuidance({passage(110.0, 0, "truth", {1.0, 2.0, 0.0}, {1.0, 2.0, 0.0}),
+                        passage(130.0, 1, "nav", {103.0, 4.0, 0.0}, {100.0, 0.0, 0.0}),
+                        passage(150.0, 2, "nav", {200.0, 12.0, 0.0}, {200.0, 0.0, 0.0})},
+                       100.0);
   EXPECT_EQ(guidance.waypoints, 3);
   EXPECT_EQ(guidance.waypoints_on_source, 2);
   EXPECT_EQ(guidance.source, "nav");

@@ -25,7 +25,8 @@ core::Trajectory straightNorth(double east_m, double speed_mps, double duration_
     const double t = i / 400.0;
     core::StampedPose pose;
     pose.t_s = 10.0 + t;
-    pose.p_ned_m = Eigen::Vector3d(speed_mps * t * std::cos(h), east_m + speed_mps * t * std::sin(h), 0.0);
+    pose.p_ned_m =
+        Eigen::Vector3d(speed_mps * t * std::cos(h), east_m + speed_mps * t * std::sin(h), 0.0);
     pose.q_world_body = core::quaternionFromRpy({0.0, 0.0, h});
     truth.push_back(pose);
   }

@@ -104,8 +104,7 @@ TEST(ExternalControlTest, ParametersThatCannotWorkAreNamed) {
     RoverRun run(aircraft);
     FAIL() << "external control of an aircraft was accepted";
   } catch (const core::ParamError& error) {
-    EXPECT_NE(std::string(error.what()).find("vehicle.control"), std::string::npos)
-        << error.what();
+    EXPECT_NE(std::string(error.what()).find("vehicle.control"), std::string::npos) << error.what();
   }
   SimParams route = roverParams();
   route.vehicle.control = "route";
