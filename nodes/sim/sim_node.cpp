@@ -65,12 +65,7 @@ void SimPublisher::publish(const SimOutput& output) {
   if (output.gps) send(sensors.gps.channel, *output.gps);
   if (output.baro) send(sensors.barometer.channel, *output.baro);
   if (output.mag) send(sensors.magnetometer.channel, *output.mag);
-  if (output.waypoint) {
-    const WaypointEvent& w = *output.waypoint;
-    send(params_.guidance.waypoint_channel,
-         msg::WaypointReached{w.utime, w.index, w.count, w.waypoint_ned_m, w.believed_ned_m,
-                              w.true_ned_m, w.source});
-  }
+  if (output.waypoint) send(params_.guidance.waypoint_channel, *output.waypoint);
   if (output.nav) {
     send(params_.truth.nav_position_channel, output.nav->position);
     send(params_.truth.nav_attitude_channel, output.nav->attitude);

@@ -287,8 +287,11 @@ SimOutput Simulator::step() {
   out.truth = currentState();
   out.truth.utime = utime_;
   if (!flight_) {
-    recent_truth_.emplace_back(utime_, out.truth.p_ned_m);
-    while (recent_truth_.front().first < utime_ - 5'000'000) recent_truth_.pop_front();
+    // Only a source's fixes need the truth of the recent past.
+    if (params_.guidance.source != "truth") {
+      recent_truth_.emplace_back(utime_, out.truth.p_ned_m);
+      while (recent_truth_.front().first < utime_ - 5'000'000) recent_truth_.pop_front();
+    }
     const std::size_t now_heading_for = vehicleNextWaypoint();
     if (!external_ && now_heading_for > heading_for && heading_for < route_.waypoints.size()) {
       WaypointEvent event;

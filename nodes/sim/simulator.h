@@ -45,16 +45,9 @@ struct DriveInput {
   double speed_mps = 0.0;
 };
 
-// The guidance took a waypoint as reached (world frame, m).
-struct WaypointEvent {
-  std::int64_t utime = 0;
-  int index = 0;
-  int count = 0;
-  Eigen::Vector3d waypoint_ned_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d believed_ned_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d true_ned_m = Eigen::Vector3d::Zero();
-  std::string source;  // what the guidance flew on then
-};
+// The guidance took a waypoint as reached (world frame, m): what the
+// simulator publishes as waypoint_reached_t, as its sensors' samples are.
+using WaypointEvent = msg::WaypointReached;
 
 // One simulation step: the true state and the sensor samples that fell due.
 struct SimOutput {
