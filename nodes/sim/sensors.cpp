@@ -83,17 +83,33 @@ ImuModel::ImuModel(const ImuParams& params)
       gyro_bias_rps_(vector3(params_.gyro_initial_bias_rps)),
       accel_bias_mps2_(vector3(params_.accel_initial_bias_mps2)) {}
 
+void ImuModel::accumulate(const VehicleState& state) {
+  const double dt_s = stepSeconds(state.utime, has_accumulated_, accumulated_utime_);
+  rate_sum_rad_ += dt_s * state.omega_body_rps;
+  force_sum_mps_ += dt_s * trueSpecificForce_mps2(state);
+  accumulated_s_ += dt_s;
+}
+
 ImuSample ImuModel::sample(const VehicleState& state) {
   const double dt_s = stepSeconds(state.utime, has_previous_, previous_utime_);
   const double sqrt_dt = std::sqrt(dt_s);
   gyro_bias_rps_ += normal3(noise_, params_.gyro_bias_random_walk_rps_rts * sqrt_dt);
   accel_bias_mps2_ += normal3(noise_, params_.accel_bias_random_walk_mps2_rts * sqrt_dt);
+  Eigen::Vector3d rate_rps = state.omega_body_rps;
+  Eigen::Vector3d force_mps2 = trueSpecificForce_mps2(state);
+  if (accumulated_s_ > 0.0) {
+    rate_rps = rate_sum_rad_ / accumulated_s_;
+    force_mps2 = force_sum_mps_ / accumulated_s_;
+  }
+  rate_sum_rad_.setZero();
+  force_sum_mps_.setZero();
+  accumulated_s_ = 0.0;
   const double sqrt_rate = std::sqrt(params_.rate_hz);
   ImuSample out;
   out.utime = state.utime;
-  out.angular_velocity_rps = state.omega_body_rps + gyro_bias_rps_ +
-                             normal3(noise_, params_.gyro_noise_density_rps_rthz * sqrt_rate);
-  out.linear_acceleration_mps2 = trueSpecificForce_mps2(state) + accel_bias_mps2_ +
+  out.angular_velocity_rps =
+      rate_rps + gyro_bias_rps_ + normal3(noise_, params_.gyro_noise_density_rps_rthz * sqrt_rate);
+  out.linear_acceleration_mps2 = force_mps2 + accel_bias_mps2_ +
                                  normal3(noise_, params_.accel_noise_density_mps2_rthz * sqrt_rate);
   return out;
 }

@@ -53,11 +53,20 @@ using ImuSample = msg::Imu;
 // per-sample sigma density * sqrt(rate_hz); the biases start at the initial
 // biases and take a random-walk step of sigma * sqrt(dt) at every call, dt
 // from the utime difference to the previous call (none at the first call).
+// The truth is the mean over the sample's interval of the states given to
+// accumulate() (as a real IMU's anti-aliasing filter and delta-velocity
+// output give it): a sample of the last state alone would alias motion that
+// changes faster than the IMU's rate (a controller's step at each position
+// fix). Without accumulated states it is the state sampled.
 class ImuModel {
  public:
   // Throws core::ParamError if a parameter is out of its range.
   explicit ImuModel(const ImuParams& params);
 
+  // One step of the truth: its rates and specific force, held over the time
+  // since the previous accumulated state (the simulator's step). Throws
+  // std::invalid_argument if state.utime is before the previous one's.
+  void accumulate(const VehicleState& state);
   // Throws std::invalid_argument if state.utime is before the previous call's.
   ImuSample sample(const VehicleState& state);
 
@@ -71,6 +80,13 @@ class ImuModel {
   Eigen::Vector3d accel_bias_mps2_;
   bool has_previous_ = false;
   std::int64_t previous_utime_ = 0;
+  // The truth accumulated since the last sample: rates and specific force
+  // times their steps' durations, and the steps' total.
+  Eigen::Vector3d rate_sum_rad_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_sum_mps_ = Eigen::Vector3d::Zero();
+  double accumulated_s_ = 0.0;
+  bool has_accumulated_ = false;
+  std::int64_t accumulated_utime_ = 0;
 };
 
 // True specific force in body FRD: R_world_body^T (a_ned - g_ned), g_ned = (0, 0, +g).

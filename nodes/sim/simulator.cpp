@@ -306,8 +306,10 @@ SimOutput Simulator::step() {
     }
   }
   const std::int64_t t = utime_;
-  if (imu_ && core::due(t, params_.sensors.imu.model.rate_hz, imu_due_)) {
-    out.imu = imu_->sample(out.truth);
+  if (imu_) {
+    imu_->accumulate(out.truth);
+    if (core::due(t, params_.sensors.imu.model.rate_hz, imu_due_))
+      out.imu = imu_->sample(out.truth);
   }
   if (rangefinder_ && core::due(t, params_.sensors.rangefinder.model.rate_hz, range_due_)) {
     out.range = rangefinder_->sample(out.truth, *world_);

@@ -250,6 +250,12 @@ void MultirotorParams::visit(core::ParamVisitor& v) {
            .max = 2000});
   v.field("yaw_at_corners", &yaw_at_corners,
           {.doc = "stop and turn to face each new leg (else keep the start heading)"});
+  v.field("acceptance_radius_m", &acceptance_radius_m,
+          {.doc = "guided on an estimate: a waypoint is reached this close horizontally, m",
+           .min = 0.01,
+           .max = 1000});
+  v.field("altitude_acceptance_m", &altitude_acceptance_m,
+          {.doc = "guided on an estimate: and this close in height, m", .min = 0.01, .max = 1000});
 }
 
 Multirotor::Multirotor(const MultirotorParams& params, const Eigen::Vector3d& start_ned,
@@ -282,15 +288,29 @@ void Multirotor::step() {
       const double yaw_step = std::clamp(yaw_error, -max_yaw_step, max_yaw_step);
       yaw_rad_ = core::wrapAngle_rad(yaw_rad_ + yaw_step);
       yaw_rate_rps = yaw_step / dt;
+    } else if (stopping_) {
+      speed_mps_ = std::max(0.0, speed_mps_ - params_.acceleration_mps2 * dt);
+      velocity = stop_direction_ * speed_mps_;
+      if (speed_mps_ == 0.0) {
+        stopping_ = false;
+        ++next_waypoint_;
+      }
     } else {
       // Accelerate to cruise, brake so as to stop on the waypoint.
       speed_mps_ = std::min({speed_mps_ + params_.acceleration_mps2 * dt,
                              speedOf(waypoints_, next_waypoint_, params_.speed_mps),
                              std::sqrt(2.0 * params_.acceleration_mps2 * distance_m)});
+      const bool accepted = on_estimate_ &&
+                            horizontal(to_target).norm() <= params_.acceptance_radius_m &&
+                            std::abs(to_target.z()) <= params_.altitude_acceptance_m;
       if (distance_m <= speed_mps_ * dt || distance_m < 1e-9) {
         velocity = to_target / dt;
         speed_mps_ = 0.0;
         ++next_waypoint_;
+      } else if (accepted) {
+        stopping_ = true;
+        stop_direction_ = to_target / distance_m;
+        velocity = stop_direction_ * speed_mps_;
       } else {
         velocity = to_target / distance_m * speed_mps_;
       }

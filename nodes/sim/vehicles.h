@@ -109,6 +109,12 @@ struct MultirotorParams {
   // needs no faster than this, deg/s (so the tilt does not jump when braking starts).
   double max_tilt_rate_dps = 60.0;
   bool yaw_at_corners = true;
+  // Guided on an estimate (setPositionError), a waypoint is reached within
+  // these of where the vehicle believes it is, horizontally and in height, as
+  // a flight controller's acceptance radii: a noisy estimate is never exactly
+  // on it. The vehicle then brakes to a stop. On the truth it stops on it.
+  double acceptance_radius_m = 0.3;
+  double altitude_acceptance_m = 0.5;
   // Integration step, s; set by the simulator (not a scenario key).
   double step_s = 0.0025;
 
@@ -124,9 +130,11 @@ class Multirotor {
       : Multirotor(params, start_ned, heading_rad, waypointsAt(waypoints_ned)) {}
   void step();
   const VehicleState& state() const { return state_; }
-  // As FixedWing::setPositionError.
+  // As FixedWing::setPositionError; from the first call on, waypoints are
+  // reached within the acceptance radii.
   void setPositionError(const Eigen::Vector3d& believed_minus_true_m) {
     position_error_m_ = believed_minus_true_m;
+    on_estimate_ = true;
   }
   const Eigen::Vector3d& positionError() const { return position_error_m_; }
   const std::vector<Waypoint>& waypoints() const { return waypoints_; }
@@ -137,6 +145,10 @@ class Multirotor {
  private:
   MultirotorParams params_;
   Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
+  bool on_estimate_ = false;
+  // Within the acceptance radii: braking to a stop along stop_direction_.
+  bool stopping_ = false;
+  Eigen::Vector3d stop_direction_ = Eigen::Vector3d::Zero();
   std::vector<Waypoint> waypoints_;
   std::size_t next_waypoint_ = 0;
   VehicleState state_;

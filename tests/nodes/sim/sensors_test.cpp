@@ -140,6 +140,33 @@ TEST(ImuModel, AccelerationRotatedIntoBody) {
   EXPECT_NEAR(s.linear_acceleration_mps2.z(), -kG, 1e-12);
 }
 
+// A state that changes faster than the IMU samples it, read as each
+// interval's mean. A 400 Hz simulation where one 2.5 ms step in four brakes a
+// climb at 2 m/s^2 down and the others climb at 0.64 m/s^2 (as a climb
+// controller does when its position fix steps at 50 Hz), sampled at 200 Hz:
+// by hand, the samples alternate (2 - 0.64) / 2 = 0.68 and -0.64 m/s^2 down,
+// so over each 10 ms they add up to the true change of velocity,
+// (0.68 - 0.64) x 5 ms = 2 x 2.5 ms - 0.64 x 7.5 ms = +0.2 mm/s; the last
+// step alone would read 2 and -0.64 (+6.8 mm/s per 10 ms). The roll rate
+// (0.4 rad/s in the braking step) likewise reads 0.2 and 0.
+TEST(ImuModel, SampleIsTheMeanOverItsInterval) {
+  ImuModel imu(quietImu());
+  for (int step = 0; step <= 40; ++step) {
+    const bool braking = step % 4 == 1;
+    VehicleState state = stateAt(step * 2500);
+    state.a_ned_mps2 = Eigen::Vector3d(0.0, 0.0, braking ? 2.0 : -0.64);
+    state.omega_body_rps = Eigen::Vector3d(braking ? 0.4 : 0.0, 0.0, 0.0);
+    imu.accumulate(state);
+    if (step % 2 == 0) continue;
+    const ImuSample s = imu.sample(state);
+    if (step == 1) continue;  // its interval is the first step alone
+    // Level: the specific force down is a_down - g.
+    EXPECT_NEAR(s.linear_acceleration_mps2.z() + kG, braking ? 0.68 : -0.64, 1e-12)
+        << "step " << step;
+    EXPECT_NEAR(s.angular_velocity_rps.x(), braking ? 0.2 : 0.0, 1e-12) << "step " << step;
+  }
+}
+
 // Initial biases add to the truth; the first call takes no random-walk step.
 TEST(ImuModel, InitialBiasAndNoStepAtFirstCall) {
   ImuParams params = quietImu();

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -175,6 +176,33 @@ TEST(Multirotor, RectangleWithNinetyDegreeYaws) {
   // Back at the start after the last leg west: yaw -90 deg.
   EXPECT_NEAR(std::remainder(drone.yaw_rad() + std::numbers::pi / 2, 2 * std::numbers::pi), 0.0,
               1e-9);
+}
+
+// Guided on a noisy estimate (its height 3 cm off one way or the other at
+// random each step, as a rangefinder's), the multirotor never stands exactly
+// on a waypoint; it takes each as reached within its acceptance radii (0.3 m
+// across, 0.5 m in height), brakes to a stop there and flies the next leg.
+// The truth ends within the radii of the last waypoint, at rest.
+TEST(Multirotor, ReachesWaypointsOnANoisyEstimateWithinItsAcceptanceRadii) {
+  MultirotorParams params;
+  const std::vector<Eigen::Vector3d> corners = {{20, 0, -5}, {20, 10, -5}, {0, 10, -5}};
+  Multirotor drone(params, {0, 0, -5}, 0.0, corners);
+  std::mt19937_64 rng(7);
+  std::size_t next_seen = 0;
+  while (!drone.finished()) {
+    drone.setPositionError(Eigen::Vector3d(0.0, 0.0, rng() % 2 == 0 ? 0.03 : -0.03));
+    drone.step();
+    if (drone.nextWaypoint() > next_seen) {
+      // Reached: at rest, and within the radii of the waypoint it left.
+      const Eigen::Vector3d off = drone.state().p_ned_m - corners[next_seen];
+      EXPECT_LE(off.head<2>().norm(), 0.3 + 1e-9) << "waypoint " << next_seen;
+      EXPECT_LE(std::abs(off.z()), 0.5 + 0.03) << "waypoint " << next_seen;
+      EXPECT_EQ(drone.state().v_ned_mps.norm(), 0.0) << "waypoint " << next_seen;
+      next_seen = drone.nextWaypoint();
+    }
+    ASSERT_LT(drone.state().utime, 200'000'000) << "hovered at waypoint " << next_seen;
+  }
+  EXPECT_EQ(next_seen, corners.size());
 }
 
 // The multirotor tilts into its acceleration: nose down to speed up forward.
