@@ -39,10 +39,12 @@ fi
 QT_QPA_PLATFORM=offscreen "$root/build/bin/nadir-calib" --virtual \
   --screenshot "$out/nadir_calib.png" >/dev/null
 
-# The closed loop: the rover's path through the gates and the slalom, and its
+# The closed loop: the rover's path through the gates, the slalom and the number 8, and its
 # steering approaching each gate (the runs' course.png and steering.png).
 "$nadir" run gates --out "$root/out/pictures-gates" --force --no-images >/dev/null
 cp "$root/out/pictures-gates/course.png" "$out/gates_course.png"
 cp "$root/out/pictures-gates/steering.png" "$out/gates_steering.png"
 "$nadir" run slalom --out "$root/out/pictures-slalom" --force --no-images >/dev/null
 cp "$root/out/pictures-slalom/course.png" "$out/slalom_course.png"
+"$nadir" run number8 --out "$root/out/pictures-number8" --force --no-images >/dev/null
+cp "$root/out/pictures-number8/course.png" "$out/number8_course.png"

@@ -32,10 +32,13 @@ struct PatternSpec {
 
 PatternSpec gateSpec() { return {{{0.38, 0.38}, {0.62, 0.38}, {0.38, 0.62}, {0.62, 0.62}}}; }
 
-// Turn right: two disks on the left, the single one on the right (an arrow head).
-PatternSpec slalomSpec(bool right) {
+// Turn right: two disks on the left, the single one on the right (an arrow
+// head), beside the column's middle to pass the board, a quarter of the
+// column lower for a 45 deg turn, higher for 135 deg.
+PatternSpec slalomSpec(bool right, double turn_deg) {
   const double near = right ? 0.37 : 0.63, tip = right ? 0.63 : 0.37;
-  return {{{near, 0.37}, {near, 0.63}, {tip, 0.5}}};
+  const double tip_y = turn_deg == 45.0 ? 0.565 : turn_deg == 135.0 ? 0.435 : 0.5;
+  return {{{near, 0.37}, {near, 0.63}, {tip, tip_y}}};
 }
 
 PatternSpec decoySpec(const CourseBoard& board) {
@@ -84,8 +87,8 @@ PatternSpec decoySpec(const CourseBoard& board) {
 
 PatternSpec specOf(const CourseBoard& board) {
   if (board.kind == "gate") return gateSpec();
-  if (board.kind == "slalom_right") return slalomSpec(true);
-  if (board.kind == "slalom_left") return slalomSpec(false);
+  if (board.kind == "slalom_right") return slalomSpec(true, board.turn_deg);
+  if (board.kind == "slalom_left") return slalomSpec(false, board.turn_deg);
   return decoySpec(board);
 }
 
@@ -131,12 +134,15 @@ void CourseBoard::visit(core::ParamVisitor& v) {
           {.doc = "the board's lower edge above the floor, m", .min = 0.0, .max = 10});
   v.field("post_m", &post_m, {.doc = "side of a post's square section, m", .min = 0.005, .max = 1});
   v.field("seed", &seed, {.doc = "decoy: which pattern of its kind", .min = 0});
+  v.field(
+      "turn_deg", &turn_deg,
+      {.doc = "slalom board: 0 pass it, 45 or 135 turn by that and go on", .min = 0, .max = 135});
 }
 
 void CourseParams::visit(core::ParamVisitor& v) {
   v.field("layout", &layout,
-          {.doc = "none, gates (eight on an S) or slalom (a line)",
-           .choices = {"none", "gates", "slalom"}});
+          {.doc = "none, gates (eight on an S), slalom (a line) or number8",
+           .choices = {"none", "gates", "slalom", "number8"}});
   v.field("north_m", &north_m,
           {.doc = "where the layout starts, north, m", .min = -1e6, .max = 1e6});
   v.field("east_m", &east_m, {.doc = "where the layout starts, east, m", .min = -1e6, .max = 1e6});
@@ -152,6 +158,15 @@ void CourseParams::visit(core::ParamVisitor& v) {
           {.doc = "slalom: distance between boards, m", .min = 0.5, .max = 100});
   v.field("slalom_boards", &slalom_boards,
           {.doc = "slalom: number of boards", .min = 1, .max = 100});
+  v.field("number8_side_m", &number8_side_m,
+          {.doc = "number8: the octagon's side, m", .min = 0.5, .max = 100});
+  v.field("number8_loop_m", &number8_loop_m,
+          {.doc = "number8: the triangle's short sides, m", .min = 0.5, .max = 100});
+  v.field(
+      "number8_turn_radius_m", &number8_turn_radius_m,
+      {.doc = "number8: the turn the boards are set for, its radius, m", .min = 0.05, .max = 100});
+  v.field("number8_trigger_m", &number8_trigger_m,
+          {.doc = "number8: and how far before a board it starts, m", .min = 0.05, .max = 100});
   v.field("board_m", &board_m, {.doc = "side of the layout's boards, m", .min = 0.05, .max = 10});
   core::visitGroupMap(v, "boards", "more boards by name", boards);
 }
@@ -212,8 +227,50 @@ std::vector<CourseBoard> courseBoards(const CourseParams& params) {
       boards.push_back(place(params.slalom_spacing_m * (i + 1), 0.0, 0.0,
                              i % 2 == 0 ? "slalom_right" : "slalom_left"));
     }
+  } else if (params.layout == "number8") {
+    // The path's corners in the layout's frame (along, across to the right):
+    // the triangle's two 135 deg left turns, then the octagon's six 45 deg
+    // right turns; each leg's heading from the last and its length. The
+    // octagon closes on the crossing when its two long legs are
+    // (1 + 1 / sqrt(2)) sides.
+    const double a = params.number8_loop_m, s = params.number8_side_m;
+    const double long_leg = (1.0 + std::sqrt(0.5)) * s;
+    struct Turn {
+      double leg_m;
+      double heading_deg;  // of the leg that ends at the corner
+      double turn_deg;     // + right
+    };
+    const std::array<Turn, 8> turns = {{{a, 0, -135},
+                                        {a * std::sqrt(2.0), -135, -135},
+                                        {a + long_leg, 90, 45},
+                                        {s, 135, 45},
+                                        {s, 180, 45},
+                                        {s, 225, 45},
+                                        {s, 270, 45},
+                                        {s, 315, 45}}};
+    Eigen::Vector2d corner(0.0, 0.0);
+    for (const Turn& turn : turns) {
+      const double hd = turn.heading_deg * kDeg;
+      const Eigen::Vector2d along(std::cos(hd), std::sin(hd));
+      corner += turn.leg_m * along;
+      // The turn starts r tan(turn / 2) before the corner; the board stands
+      // the trigger distance beyond that start, facing the car.
+      const double lead_m =
+          params.number8_turn_radius_m * std::tan(0.5 * std::abs(turn.turn_deg) * kDeg);
+      const Eigen::Vector2d at = corner + (params.number8_trigger_m - lead_m) * along;
+      CourseBoard board = place(at.x(), at.y(), turn.heading_deg,
+                                turn.turn_deg > 0 ? "slalom_right" : "slalom_left");
+      board.turn_deg = std::abs(turn.turn_deg);
+      boards.push_back(board);
+    }
   }
   for (const auto& [name, board] : params.boards) boards.push_back(board);
+  for (const CourseBoard& board : boards) {
+    if (board.turn_deg != 0.0 && board.turn_deg != 45.0 && board.turn_deg != 135.0) {
+      throw core::ParamError("course: a board's turn_deg is " + std::to_string(board.turn_deg) +
+                             ": its pattern says 0 (pass it), 45 or 135");
+    }
+  }
   return boards;
 }
 

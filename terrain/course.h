@@ -41,13 +41,20 @@ struct CourseBoard {
   double post_m = 0.03;
   // decoy: which pattern of its kind.
   std::int64_t seed = 1;
+  // Slalom boards: 0 asks to pass the board on its side and come back (the
+  // single disk beside the column's middle); 45 or 135 asks to turn by that
+  // much to its side and go on to the next board (the disk a quarter of the
+  // column below or above its middle), as the number 8 of Liu et al. (2021).
+  double turn_deg = 0.0;
 
   void visit(core::ParamVisitor& v);
 };
 
 struct CourseParams {
-  // none, gates (eight gates on an S through the arena) or slalom (boards in
-  // a line, alternately passed on the right and the left).
+  // none, gates (eight gates on an S through the arena), slalom (boards in
+  // a line, alternately passed on the right and the left) or number8 (eight
+  // turn boards: two 135 deg left turns around a triangle, six 45 deg right
+  // turns around a cut octagon, crossing where the layout starts).
   std::string layout = "none";
   // Where the layout starts and the direction it runs, world frame.
   double north_m = 0.0;
@@ -60,6 +67,13 @@ struct CourseParams {
   // slalom: boards this far apart, m, and how many.
   double slalom_spacing_m = 2.4;
   int slalom_boards = 6;
+  // number8: the octagon's side and the triangle's short sides, m; and the
+  // turn the boards are set for: a car turning on turn_radius_m that starts
+  // its turn trigger_m before a board.
+  double number8_side_m = 1.5;
+  double number8_loop_m = 2.5;
+  double number8_turn_radius_m = 0.45;
+  double number8_trigger_m = 0.8;
   // The boards' size, for every board of the layout.
   double board_m = 0.45;
   // More boards by name (after the layout's, in name order).

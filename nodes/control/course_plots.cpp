@@ -123,10 +123,10 @@ void writeCoursePlots(const CourseRunInput& input, const logs::CourseMetrics& me
   char title[256];
   std::snprintf(title, sizeof title,
                 "the rover's path (body centre), coloured by speed: blue 0, red %.2f m/s;  "
-                "gates %d/%d passed, %d hit; average %.2f m/s",
-                top_speed, metrics.gates_passed + metrics.slalom_passed,
-                metrics.gates + metrics.slalom_boards, metrics.gates_hit + metrics.slalom_hit,
-                metrics.average_speed_mps);
+                "%s %d/%d passed, %d hit; average %.2f m/s",
+                top_speed, metrics.gates > 0 ? "gates" : "boards",
+                metrics.gates_passed + metrics.slalom_passed, metrics.gates + metrics.slalom_boards,
+                metrics.gates_hit + metrics.slalom_hit, metrics.average_speed_mps);
   text(image, title, {kMargin, 30}, 0.55);
   text(image, "north to the right, east down; posts and boards to scale, decoys grey",
        {kMargin, 52}, 0.45, kGrey);

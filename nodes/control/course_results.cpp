@@ -17,6 +17,15 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kPassageReach_m = 2.0;
 // Moving: faster than this, m/s.
 constexpr double kMoving_mps = 0.05;
+// A turn board is approached when the body, still in front of it, comes this
+// close heading within kApproach_deg of its axis; the turn it asks for must
+// come within kTurnTravel_m of travel after that and reach kTurnShare of its
+// angle; it ends when the yaw rate falls under kTurnEnd_rps.
+constexpr double kApproach_m = 1.5;
+constexpr double kApproach_deg = 45.0;
+constexpr double kTurnTravel_m = 3.0;
+constexpr double kTurnShare = 0.7;
+constexpr double kTurnEnd_rps = 0.3;
 // Liu et al. (2021) table 2, us: capture and threshold, flooding, de-noising,
 // the disks' coordinates, their transfer, the PID.
 constexpr std::array<double, 6> kPaperUs = {52.0, 63.0, 4.0, 328.0, 24.0, 1.0};
@@ -71,6 +80,51 @@ bool overlap(const FloorRectangle& a, const FloorRectangle& b) {
   return true;
 }
 
+namespace {
+
+// A turn board's first approach: from there, the heading's change over the
+// next kTurnTravel_m of travel. Turned (crossed) once it changes by
+// kTurnShare of the angle either way, at the time it first changes by half;
+// passed when that is to the board's side. heading_error_deg: the change at
+// the turn's end less the angle asked (signed to the board's side);
+// offset_m: not a crossing (NaN).
+void scoreTurn(const core::Trajectory& truth, const std::vector<FloorRectangle>& body,
+               const terrain::CourseBoard& board, logs::BoardPassage& passage) {
+  const double h = board.heading_deg * kDeg;
+  const Eigen::Vector2d centre(board.north_m, board.east_m);
+  const double side = board.kind == "slalom_right" ? 1.0 : -1.0;
+  std::size_t start = body.size();
+  for (std::size_t i = 0; i < body.size(); ++i) {
+    const Eigen::Vector2d p(body[i].north_m, body[i].east_m);
+    const Eigen::Vector2d forward(std::cos(h), std::sin(h));
+    if ((p - centre).norm() <= kApproach_m && (p - centre).dot(forward) < 0.0 &&
+        std::abs(core::wrapAngle_rad(body[i].heading_rad - h)) <= kApproach_deg * kDeg) {
+      start = i;
+      break;
+    }
+  }
+  if (start == body.size()) return;
+  const double asked = board.turn_deg * kDeg;
+  double change = 0.0, travel = 0.0;
+  for (std::size_t i = start + 1; i < body.size() && travel <= kTurnTravel_m; ++i) {
+    const double step = core::wrapAngle_rad(body[i].heading_rad - body[i - 1].heading_rad);
+    const double dt = truth[i].t_s - truth[i - 1].t_s;
+    change += step;
+    travel += (truth[i].p_ned_m - truth[i - 1].p_ned_m).head<2>().norm();
+    if (std::isnan(passage.time_s) && std::abs(change) >= 0.5 * asked) {
+      passage.time_s = truth[i].t_s - truth.front().t_s;
+    }
+    if (!passage.crossed && std::abs(change) >= kTurnShare * asked) {
+      passage.crossed = true;
+      passage.passed = side * change > 0.0;
+    }
+    if (passage.crossed && dt > 0.0 && std::abs(step) / dt < kTurnEnd_rps) break;
+  }
+  if (passage.crossed) passage.heading_error_deg = (side * change - asked) / kDeg;
+}
+
+}  // namespace
+
 logs::CourseMetrics courseResults(const CourseRunInput& input) {
   const core::Trajectory& truth = input.truth;
   if (truth.size() < 2) {
@@ -108,9 +162,15 @@ logs::CourseMetrics courseResults(const CourseRunInput& input) {
     passage.kind = board.kind;
     passage.hit = hit;
     const double h = board.heading_deg * kDeg;
+    const bool turn = slalom && board.turn_deg > 0.0;
+    if (turn) {
+      passage.kind = board.kind == "slalom_right" ? "turn_right" : "turn_left";
+      scoreTurn(truth, body, board, passage);
+      if (passage.crossed) last_crossing_s = std::max(last_crossing_s, passage.time_s);
+    }
     const Eigen::Vector2d forward(std::cos(h), std::sin(h)), right(-std::sin(h), std::cos(h));
     const Eigen::Vector2d centre(board.north_m, board.east_m);
-    for (std::size_t i = 1; i < body.size() && !passage.crossed; ++i) {
+    for (std::size_t i = 1; !turn && i < body.size() && !passage.crossed; ++i) {
       const Eigen::Vector2d a(body[i - 1].north_m, body[i - 1].east_m);
       const Eigen::Vector2d b(body[i].north_m, body[i].east_m);
       const double da = (a - centre).dot(forward), db = (b - centre).dot(forward);
@@ -225,15 +285,27 @@ std::string formatCourse(const logs::CourseMetrics& m) {
   }
   if (m.slalom_boards > 0) {
     out += "slalom: " + std::to_string(m.slalom_passed) + " of " + std::to_string(m.slalom_boards) +
-           " boards passed on their side, " + std::to_string(m.slalom_wrong_side) +
-           " on the wrong side, " + std::to_string(m.slalom_missed) + " missed, " +
-           std::to_string(m.slalom_hit) + " hit\n";
+           " boards passed on their side or turned at their way, " +
+           std::to_string(m.slalom_wrong_side) + " the wrong way, " +
+           std::to_string(m.slalom_missed) + " missed, " + std::to_string(m.slalom_hit) + " hit\n";
   }
   out += "speed: average " + number(m.average_speed_mps, 2) + " m/s over " +
          number(m.distance_m, 1) + " m in " + number(m.duration_s, 1) + " s, peak " +
          number(m.peak_speed_mps, 2) + " m/s\n";
   for (std::size_t i = 0; i < m.passages.size(); ++i) {
     const logs::BoardPassage& p = m.passages[i];
+    if (p.kind == "turn_left" || p.kind == "turn_right") {
+      out += "  " + std::to_string(i + 1) + " " + p.kind + ": " +
+             (p.passed    ? "turned its way"
+              : p.crossed ? "turned the wrong way"
+                          : "missed") +
+             (p.hit ? ", post hit" : "") +
+             (p.crossed ? " at " + number(p.time_s, 2) + " s, " + number(p.heading_error_deg, 1) +
+                              " deg beyond the turn asked"
+                        : "") +
+             "\n";
+      continue;
+    }
     out +=
         "  " + std::to_string(i + 1) + " " + p.kind + ": " +
         (p.passed    ? "passed"

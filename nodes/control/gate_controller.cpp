@@ -34,6 +34,14 @@ void SlalomParams::visit(core::ParamVisitor& v) {
           {.doc = "distance between the board's column disks, share of its side",
            .min = 0.01,
            .max = 1});
+  v.field("low_turn_deg", &low_turn_deg,
+          {.doc = "the turn a board asks for with its single disk below the middle, deg",
+           .min = 1,
+           .max = 180});
+  v.field("high_turn_deg", &high_turn_deg,
+          {.doc = "the turn a board asks for with its single disk above the middle, deg",
+           .min = 1,
+           .max = 180});
 }
 
 void GateControllerParams::visit(core::ParamVisitor& v) {
@@ -109,6 +117,18 @@ double deformationOf(const PatternObservation& pattern) {
   return left / right - 1.0;
 }
 
+double boardTurn_deg(const PatternObservation& pattern, const SlalomParams& params) {
+  const bool slalom = pattern.kind == Pattern::kSlalomLeft || pattern.kind == Pattern::kSlalomRight;
+  if (!slalom || pattern.disks_px.size() != 3) return 0.0;
+  const auto& d = pattern.disks_px;  // column top, column bottom, tip
+  const double column_px = d[1].y() - d[0].y();
+  if (!(column_px > 0.0)) return 0.0;
+  const double tip_share = (d[2].y() - d[0].y()) / column_px;
+  if (tip_share < 0.375) return params.high_turn_deg;
+  if (tip_share > 0.625) return params.low_turn_deg;
+  return 0.0;
+}
+
 double GateController::Pid::step(const PidGains& gains, double error, double dt_s) {
   double derivative = 0.0;
   if (has_previous && dt_s > 0.0) {
@@ -172,12 +192,13 @@ SteeringCommand GateController::manoeuvre(std::int64_t utime) {
   } else if (t < turn_s_ + straight_s_) {
     command.steer_rad = 0.0;
   } else {
-    // Turning back towards the line of boards until the next one is in view
-    // (update() takes it from there), blind no longer than lost() allows.
+    // Turning back towards the line of boards (or, after a turn, straight on)
+    // until the next board is in view (update() takes it from there), blind
+    // no longer than lost() allows.
     in_manoeuvre_ = false;
-    returning_ = true;
+    returning_ = !go_on_;
     last_seen_utime_ = utime;
-    return returnTurn(utime);
+    return returning_ ? returnTurn(utime) : lost(utime);
   }
   return command;
 }
@@ -251,8 +272,10 @@ SteeringCommand GateController::update(const PatternObservation& pattern, const 
         radius_m = std::max(radius_m, speed * speed / params_.max_lateral_acceleration_mps2);
       }
       manoeuvre_steer_rad_ = std::atan(params_.wheelbase_m / radius_m);
-      turn_s_ = params_.slalom.turn_deg * kDeg * radius_m / speed;
-      straight_s_ = params_.slalom.straight_m / speed;
+      const double asked_deg = boardTurn_deg(pattern, params_.slalom);
+      go_on_ = asked_deg > 0.0;
+      turn_s_ = (go_on_ ? asked_deg : params_.slalom.turn_deg) * kDeg * radius_m / speed;
+      straight_s_ = go_on_ ? 0.0 : params_.slalom.straight_m / speed;
       manoeuvre_side_ = pattern.kind == Pattern::kSlalomRight ? 1.0 : -1.0;
       manoeuvre_start_ = pattern.utime;
       in_manoeuvre_ = true;

@@ -22,7 +22,11 @@
 // slalom.turn_deg (at full lock, or as tight as its tyres hold at its speed),
 // goes straight for slalom.straight_m, all on its own commands (no other
 // sensor), and turns back the other way until the next board is in view
-// (blind no longer than coast_s and stop_s allow).
+// (blind no longer than coast_s and stop_s allow). A board whose single disk
+// sits a quarter of its column below or above the column's middle asks for a
+// turn of slalom.low_turn_deg or slalom.high_turn_deg instead: the rover turns
+// by that much to its side and goes straight on until it sees the next board
+// (the number 8), again blind no longer than coast_s and stop_s allow.
 // docs/closed_loop.md has the method and the figures.
 
 #include <cstdint>
@@ -53,6 +57,10 @@ struct SlalomParams {
   double straight_m = 0.35;
   // The board's disk column: its disks' centres are this share of the board's side apart.
   double column_share = 0.26;
+  // The turns a board's single disk asks for below and above its column's
+  // middle, deg (turn and go on).
+  double low_turn_deg = 45.0;
+  double high_turn_deg = 135.0;
 
   void visit(core::ParamVisitor& v);
 };
@@ -121,6 +129,9 @@ double patternDistance_m(const PatternObservation& pattern, const Lens& lens,
 // The pattern's D_y (rad) and delta_y for a lens and reference column.
 double lateralError_rad(const PatternObservation& pattern, const Lens& lens, double reference_x_px);
 double deformationOf(const PatternObservation& pattern);
+// What a slalom board asks for: 0 to pass it (the single disk level with the
+// column's middle, within an eighth of the column), else the turn in deg.
+double boardTurn_deg(const PatternObservation& pattern, const SlalomParams& params);
 
 class GateController {
  public:
@@ -164,6 +175,8 @@ class GateController {
   double manoeuvre_steer_rad_ = 0.0;
   // After a slalom turn: turning back until the next board is in view.
   bool returning_ = false;
+  // The manoeuvre is a turn that goes straight on after it (no turn back).
+  bool go_on_ = false;
 };
 
 }  // namespace nadir::control

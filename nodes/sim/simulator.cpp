@@ -214,7 +214,7 @@ bool Simulator::guidanceOnSource(std::int64_t utime) const {
 }
 
 std::string Simulator::guidanceSource() const {
-  return guidanceOnSource(utime_) ? params_.guidance.source : "truth";
+  return guidanceOnSource(utime_) && has_source_fix_ ? params_.guidance.source : "truth";
 }
 
 void Simulator::setPositionError(const Eigen::Vector3d& error_m) {
@@ -254,6 +254,7 @@ void Simulator::positionFix(std::int64_t utime, const Eigen::Vector3d& p_ned_m) 
     p_true = before->second + share * (after->second - before->second);
   }
   setPositionError(p_ned_m - p_true);
+  has_source_fix_ = true;
 }
 
 bool Simulator::finished() const {

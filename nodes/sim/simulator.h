@@ -92,7 +92,8 @@ class Simulator {
   // its error against the truth at its time held until the next. A fix older
   // than the truth kept (5 s) or newer than now is ignored.
   void positionFix(std::int64_t utime, const Eigen::Vector3d& p_ned_m);
-  // What the guidance flies on now.
+  // What the guidance flies on now: the truth until the source's first fix
+  // (a source that never gives one is never flown on, nor reported as such).
   std::string guidanceSource() const;
 
   std::int64_t startUtime() const { return start_utime_; }
@@ -123,6 +124,7 @@ class Simulator {
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> recent_truth_;
   std::size_t next_waypoint_ = 0;
   Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
+  bool has_source_fix_ = false;
   void setPositionError(const Eigen::Vector3d& error_m);
   std::size_t vehicleNextWaypoint() const;
   bool guidanceOnSource(std::int64_t utime) const;

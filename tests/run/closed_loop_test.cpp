@@ -1,4 +1,4 @@
-// The closed loop in sim time: the rover on the gate course and the slalom,
+// The closed loop in sim time: the rover on the gate course, the slalom and the number 8,
 // steered by the emulated SCAMP-5's disks through nadir-control, scored from
 // the truth; the same run twice gives byte-identical logs; without the chip
 // the rover never moves.
@@ -77,6 +77,19 @@ TEST(ClosedLoop, TheFastSlalom) {
   EXPECT_EQ(course.slalom_passed, 6);
   EXPECT_EQ(course.slalom_hit, 0);
   EXPECT_GE(course.peak_speed_mps, 3.9);
+}
+
+// The number 8: each of the eight boards turned at its way (two 135 deg
+// left, six 45 deg right), none touched, the lap flown at speed (Liu et al.
+// 2021: 1.70 m/s on average).
+TEST(ClosedLoop, TheNumberEight) {
+  const RunResult result = runCourse("number8", "number8");
+  ASSERT_TRUE(result.metrics.course.has_value());
+  const logs::CourseMetrics& course = *result.metrics.course;
+  EXPECT_EQ(course.slalom_boards, 8);
+  EXPECT_EQ(course.slalom_passed, 8) << result.table;
+  EXPECT_EQ(course.slalom_hit, 0);
+  EXPECT_GE(course.average_speed_mps, 1.7);
 }
 
 // Without the chip's patterns the controller commands nothing and the rover

@@ -1,6 +1,7 @@
 // The course's scoring against hand-worked cases: the footprints' overlap, a
 // gate passed through its opening or beside it, a post touched, a slalom board
-// passed on its side, the speeds, and the pipeline's means.
+// passed on its side, a turn board turned at its way, the speeds, and the
+// pipeline's means.
 
 #include "nodes/control/course_results.h"
 
@@ -117,6 +118,76 @@ TEST(CourseResultsTest, SlalomBoardsByTheirSide) {
 }
 
 // A crossing 20 deg off the gate's axis reports it.
+// A drive north at 2 m/s that, 1 m short of a board, turns on a 0.5 m
+// radius by turn_deg (+ right) and goes straight on; 400 Hz.
+core::Trajectory northThenTurn(double turn_deg) {
+  core::Trajectory truth;
+  constexpr double kSpeed = 2.0, kRadius = 0.5, kTurnAt = 1.0;
+  const double turn = std::abs(turn_deg) * kDeg, side = turn_deg > 0.0 ? 1.0 : -1.0;
+  const double arc_s = turn * kRadius / kSpeed;
+  for (int i = 0; i <= 1600; ++i) {
+    const double t = i / 400.0, along = kSpeed * t;
+    core::StampedPose pose;
+    pose.t_s = t;
+    double heading = 0.0;
+    Eigen::Vector2d p(along - 2.0, 0.0);
+    if (p.x() > -kTurnAt) {
+      const double since = t - (2.0 - kTurnAt) / kSpeed;
+      const double angle = std::min(since, arc_s) * kSpeed / kRadius;
+      heading = side * angle;
+      // On the arc: centre kRadius to the turn's side of the turn's start.
+      p = Eigen::Vector2d(-kTurnAt + kRadius * std::sin(angle),
+                          side * kRadius * (1.0 - std::cos(angle)));
+      if (since > arc_s)
+        p += kSpeed * (since - arc_s) * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    }
+    pose.p_ned_m = Eigen::Vector3d(p.x(), p.y(), 0.0);
+    pose.q_world_body = core::quaternionFromRpy({0.0, 0.0, heading});
+    truth.push_back(pose);
+  }
+  return truth;
+}
+
+// Turn boards at the origin facing north: turning 45 deg right at a board
+// that asks for 45 right is its way (turned 0 deg beyond it, half the turn
+// reached at 0.5 s + 22.5 deg x 0.5 m / 2 m/s = 0.5982 s); turning left is the
+// wrong way; a 45 deg turn at a 135 deg board is missed (under 0.7 x 135);
+// a board never approached is missed.
+TEST(CourseResultsTest, TurnBoardsByTheTurnMade) {
+  terrain::CourseBoard right;
+  right.kind = "slalom_right";
+  right.turn_deg = 45.0;
+  CourseRunInput input;
+  input.truth = northThenTurn(45.0);
+  input.boards = {right};
+  logs::CourseMetrics m = courseResults(input);
+  ASSERT_EQ(m.passages.size(), 1u);
+  EXPECT_EQ(m.passages[0].kind, "turn_right");
+  EXPECT_TRUE(m.passages[0].passed);
+  EXPECT_NEAR(m.passages[0].heading_error_deg, 0.0, 1e-6);
+  EXPECT_NEAR(m.passages[0].time_s, 0.5 + 22.5 * kDeg * 0.5 / 2.0, 2.5e-3);
+  EXPECT_EQ(m.slalom_passed, 1);
+
+  input.truth = northThenTurn(-45.0);
+  m = courseResults(input);
+  EXPECT_TRUE(m.passages[0].crossed);
+  EXPECT_FALSE(m.passages[0].passed);
+  EXPECT_EQ(m.slalom_wrong_side, 1);
+
+  right.turn_deg = 135.0;
+  input.truth = northThenTurn(45.0);
+  input.boards = {right};
+  m = courseResults(input);
+  EXPECT_FALSE(m.passages[0].crossed);
+  EXPECT_EQ(m.slalom_missed, 1);
+
+  right.north_m = 20.0;
+  input.boards = {right};
+  m = courseResults(input);
+  EXPECT_FALSE(m.passages[0].crossed);
+  EXPECT_EQ(m.slalom_missed, 1);
+}
+
 TEST(CourseResultsTest, HeadingOffTheAxis) {
   CourseRunInput input;
   input.truth = straightNorth(-0.5, 2.0, 3.0, 20.0);

@@ -2,7 +2,8 @@
 // towards its axis by the PIDs' sum; a lost or missing pattern slows the rover
 // to a stop and never lets it drive on blind at speed; a gate lost close by
 // is driven through straight; a slalom board within the trigger turns the
-// rover to the side it shows.
+// rover to the side it shows; a turn board turns it by what it asks and lets
+// it go on.
 
 #include "nodes/control/gate_controller.h"
 
@@ -34,6 +35,21 @@ PatternObservation gate(std::int64_t utime, double x_left, double x_right, doubl
 PatternObservation nothing(std::int64_t utime) {
   PatternObservation p;
   p.utime = utime;
+  return p;
+}
+
+// A slalom board (column 0.26 x 0.45 m tall) distance_m ahead, its column at
+// x = 120 px centred on row 128, its single disk on side (+1 right) at
+// tip_share of the column from its top.
+PatternObservation slalomBoard(Pattern kind, double side, std::int64_t utime, double distance_m,
+                               double tip_share) {
+  PatternObservation p;
+  p.utime = utime;
+  p.kind = kind;
+  const double column_px = 0.26 * 0.45 * kLens.fy / distance_m;
+  p.disks_px = {{120.0, 128.0 - 0.5 * column_px},
+                {120.0, 128.0 + 0.5 * column_px},
+                {120.0 + side * 0.5 * column_px, 128.0 + (tip_share - 0.5) * column_px}};
   return p;
 }
 
@@ -153,14 +169,7 @@ TEST(GateControllerTest, ASlalomBoardTurnsTheRoverToItsSide) {
        {std::pair{Pattern::kSlalomRight, 1.0}, std::pair{Pattern::kSlalomLeft, -1.0}}) {
     GateController controller(params);
     const auto board = [&](std::int64_t utime, double distance_m) {
-      PatternObservation p;
-      p.utime = utime;
-      p.kind = kind;
-      const double column_px = 0.26 * 0.45 * kLens.fy / distance_m;
-      p.disks_px = {{120.0, 128.0 - 0.5 * column_px},
-                    {120.0, 128.0 + 0.5 * column_px},
-                    {120.0 + side * 0.5 * column_px, 128.0}};
-      return p;
+      return slalomBoard(kind, side, utime, distance_m, 0.5);
     };
     EXPECT_EQ(controller.update(board(0, 2.0), kLens).mode, DriveMode::kTracking);
     const SteeringCommand turn = controller.update(board(5'000, 1.25), kLens);
@@ -172,6 +181,59 @@ TEST(GateControllerTest, ASlalomBoardTurnsTheRoverToItsSide) {
     const SteeringCommand back = controller.update(nothing(220'000), kLens);
     EXPECT_EQ(back.mode, DriveMode::kManoeuvre);
     EXPECT_NEAR(back.steer_rad, -side * 0.161092, 1e-6);
+  }
+}
+
+// A turn board's single disk a quarter of its 40 px column above its middle
+// (row 100 + 10 = 110 of 100..140) asks for 135 deg, a quarter below (130)
+// for 45 deg, level (120) to pass; within an eighth of the column (115 and
+// 125) still level.
+TEST(GateControllerTest, ATurnBoardsSingleDiskSaysHowFar) {
+  const SlalomParams params;  // 45 and 135 deg
+  const auto board = [](Pattern kind, double tip_y) {
+    PatternObservation p;
+    p.kind = kind;
+    p.disks_px = {{100.0, 100.0}, {100.0, 140.0}, {120.0, tip_y}};
+    return p;
+  };
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kSlalomRight, 110.0), params), 135.0);
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kSlalomRight, 130.0), params), 45.0);
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kSlalomLeft, 120.0), params), 0.0);
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kSlalomLeft, 115.5), params), 0.0);
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kSlalomLeft, 124.5), params), 0.0);
+  EXPECT_EQ(boardTurn_deg(board(Pattern::kGate, 110.0), params), 0.0);
+}
+
+// A 45 deg board within the trigger at 2 m/s: at full lock (30 deg, radius
+// 0.26 / tan(30 deg) = 0.450333 m; the grip's 2^2 / 10 = 0.4 m is wider)
+// the rover turns to the board's side for 45 deg x 0.450333 m / 2 m/s =
+// 0.176819 s, then goes straight on at speed (no turn back) until it sees the
+// next board, and coasts then stops when it sees none.
+TEST(GateControllerTest, ATurnBoardTurnsTheRoverAndGoesOn) {
+  GateControllerParams params = plainParams();
+  params.cruise_speed_mps = 2.0;
+  params.max_lateral_acceleration_mps2 = 10.0;
+  params.slalom.trigger_m = 0.8;
+  for (const auto& [kind, side] :
+       {std::pair{Pattern::kSlalomRight, 1.0}, std::pair{Pattern::kSlalomLeft, -1.0}}) {
+    GateController controller(params);
+    const auto board = [&](std::int64_t utime, double distance_m) {
+      return slalomBoard(kind, side, utime, distance_m, 0.75);
+    };
+    EXPECT_EQ(controller.update(board(0, 2.0), kLens).mode, DriveMode::kTracking);
+    const SteeringCommand turn = controller.update(board(5'000, 0.78), kLens);
+    EXPECT_EQ(turn.mode, DriveMode::kManoeuvre);
+    const double lock = 30.0 * std::numbers::pi / 180.0;
+    EXPECT_NEAR(turn.steer_rad, side * lock, 1e-9);
+    EXPECT_NEAR(controller.update(nothing(5'000 + 175'000), kLens).steer_rad, side * lock, 1e-9);
+    const SteeringCommand on = controller.update(nothing(5'000 + 178'000), kLens);
+    EXPECT_EQ(on.mode, DriveMode::kCoasting);
+    EXPECT_EQ(on.steer_rad, 0.0);
+    EXPECT_EQ(on.speed_mps, 2.0);
+    // Blind: coasting 0.4 s from the turn's end, then stopping over 0.5 s.
+    EXPECT_EQ(controller.update(nothing(5'000 + 178'000 + 600'000), kLens).mode,
+              DriveMode::kStopping);
+    EXPECT_EQ(controller.update(nothing(5'000 + 178'000 + 1'000'000), kLens).speed_mps, 0.0);
   }
 }
 

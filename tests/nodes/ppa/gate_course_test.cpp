@@ -2,8 +2,8 @@
 // forward PPA camera at 1, 2 and 4 m, head-on and 20 deg off its axis, gives
 // disk centres within 1 px of the pinhole projection of the true disk centres
 // (worked out here from the board's drawing: 0.45 m board 0.2 m above the
-// floor, disks at 0.38 and 0.62 of its side). Slalom boards read their side;
-// decoys alone are never a gate.
+// floor, disks at 0.38 and 0.62 of its side). Slalom boards read their side,
+// turn boards their turn; decoys alone are never a gate.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "bench/ppa_scenes.h"
+#include "nodes/control/gate_controller.h"
 #include "nodes/ppa/gate_tracker.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
@@ -143,6 +144,35 @@ TEST(GateCourseTest, SlalomBoardsSayWhichWay) {
           trackImage(tracker, scene.camera->render(cameraAt(distance, 10.0), 0).image);
       EXPECT_EQ(result.kind, expected) << kind << " at " << distance << " m";
       EXPECT_EQ(result.num_disks, 3);
+    }
+  }
+}
+
+// A turn board's single disk, a quarter of its column above or below the
+// column's middle (135 or 45 deg), or level with it (pass the board), read by
+// the chip at 1, 2.5 and 4 m, 10 deg off its axis, and by the controller's
+// reading of the disks: the turn the board asks for.
+TEST(GateCourseTest, TurnBoardsSayHowFar) {
+  for (const char* kind : {"slalom_right", "slalom_left"}) {
+    for (const double turn_deg : {0.0, 45.0, 135.0}) {
+      terrain::CourseBoard board = boardAtOrigin(kind);
+      board.turn_deg = turn_deg;
+      Scene scene({board});
+      for (const double distance : {1.0, 2.5, 4.0}) {
+        GateTracker tracker{trackerParams()};
+        const GateResult result =
+            trackImage(tracker, scene.camera->render(cameraAt(distance, 10.0), 0).image);
+        ASSERT_EQ(result.num_disks, 3) << kind << " " << turn_deg << " at " << distance << " m";
+        control::PatternObservation seen;
+        seen.kind = result.kind == PatternKind::kSlalomRight  ? control::Pattern::kSlalomRight
+                    : result.kind == PatternKind::kSlalomLeft ? control::Pattern::kSlalomLeft
+                                                              : control::Pattern::kNone;
+        for (int i = 0; i < 3; ++i) {
+          seen.disks_px.emplace_back(result.disk_centres_px[i][0], result.disk_centres_px[i][1]);
+        }
+        EXPECT_EQ(control::boardTurn_deg(seen, control::SlalomParams{}), turn_deg)
+            << kind << " at " << distance << " m";
+      }
     }
   }
 }

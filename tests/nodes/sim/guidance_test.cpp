@@ -70,7 +70,9 @@ TEST(GuidanceTest, OnTheTruthTheFixesAreIgnored) {
 
 // On a source 3 m north and 4 m west of the truth from the start (no denial):
 // it stops where it believes the waypoints are, so truly 5 m from each, at
-// (17, 4) and (17, 24) m, and reports the 5 m.
+// (17, 4) and (17, 24) m, and reports the 5 m. (Within its acceptance radius
+// it brakes to a stop on the profile that ends on the waypoint: within a few
+// mm of it, not exactly on it.)
 TEST(GuidanceTest, OnASourceTheTruthEndsOffByItsError) {
   Flight flight(squareLeg("nav", -1.0));
   const Eigen::Vector3d error(3.0, -4.0, 0.0);
@@ -78,11 +80,11 @@ TEST(GuidanceTest, OnASourceTheTruthEndsOffByItsError) {
   ASSERT_EQ(flight.events.size(), 2u);
   for (const WaypointEvent& e : flight.events) {
     EXPECT_EQ(e.source, "nav");
-    EXPECT_NEAR((e.believed_ned_m - e.waypoint_ned_m).norm(), 0.0, 1e-6);
+    EXPECT_NEAR((e.believed_ned_m - e.waypoint_ned_m).norm(), 0.0, 0.005);
     EXPECT_NEAR((e.true_ned_m - e.believed_ned_m).norm(), 5.0, 1e-6);
   }
-  EXPECT_NEAR(flight.events[1].true_ned_m.x(), 17.0, 1e-6);
-  EXPECT_NEAR(flight.events[1].true_ned_m.y(), 24.0, 1e-6);
+  EXPECT_NEAR(flight.events[1].true_ned_m.x(), 17.0, 0.005);
+  EXPECT_NEAR(flight.events[1].true_ned_m.y(), 24.0, 0.005);
 }
 
 // With the GPS denied after 3 s, the first waypoint (reached at 5.3 s) is
@@ -97,7 +99,7 @@ TEST(GuidanceTest, TheSourceTakesOverAtTheDenial) {
   early.fly(Eigen::Vector3d(3.0, -4.0, 0.0));
   ASSERT_EQ(early.events.size(), 2u);
   EXPECT_EQ(early.events[0].source, "vo_feature");
-  EXPECT_NEAR((early.events[0].true_ned_m - early.events[0].waypoint_ned_m).norm(), 5.0, 1e-6);
+  EXPECT_NEAR((early.events[0].true_ned_m - early.events[0].waypoint_ned_m).norm(), 5.0, 0.005);
 }
 
 // A fix for a time the simulator no longer holds (older than 5 s) or not yet
