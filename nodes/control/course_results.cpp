@@ -92,11 +92,11 @@ void scoreTurn(const core::Trajectory& truth, const std::vector<FloorRectangle>&
                const terrain::CourseBoard& board, logs::BoardPassage& passage) {
   const double h = board.heading_deg * kDeg;
   const Eigen::Vector2d centre(board.north_m, board.east_m);
+  const Eigen::Vector2d forward(std::cos(h), std::sin(h));
   const double side = board.kind == "slalom_right" ? 1.0 : -1.0;
   std::size_t start = body.size();
   for (std::size_t i = 0; i < body.size(); ++i) {
     const Eigen::Vector2d p(body[i].north_m, body[i].east_m);
-    const Eigen::Vector2d forward(std::cos(h), std::sin(h));
     if ((p - centre).norm() <= kApproach_m && (p - centre).dot(forward) < 0.0 &&
         std::abs(core::wrapAngle_rad(body[i].heading_rad - h)) <= kApproach_deg * kDeg) {
       start = i;
