@@ -1,4 +1,4 @@
-// nadir log info|cut|play: look into, cut and replay LCM logs (logs/).
+// nadir log info|cut|play|record: look into, cut, replay and record LCM logs (logs/).
 #include "cli/commands.h"
 
 #include <CLI/CLI.hpp>
@@ -10,12 +10,15 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +28,9 @@
 #include "logs/log_cut.h"
 #include "logs/log_info.h"
 #include "logs/log_player.h"
+#include "logs/log_recorder.h"
+#include "nodes/registry.h"
+#include "nodes/scenario.h"
 
 namespace nadir::cli {
 namespace {
@@ -53,6 +59,18 @@ struct LogPlayCommandOptions {
   bool loop = false;
   std::vector<std::string> remap;
   std::string channels;
+  std::string image_encoding = "as-recorded";
+};
+
+struct LogRecordCommandOptions {
+  std::string log;
+  std::string url;
+  std::string channels;
+  std::vector<std::string> rates;
+  std::string scenario;
+  double idle_stop_s = 0.0;
+  double duration_s = 0.0;
+  bool force = false;
 };
 
 void runLogInfo(const LogInfoCommandOptions& options) {
@@ -203,6 +221,7 @@ void runLogPlay(const LogPlayCommandOptions& options) {
   player_options.start_s = options.start_s;
   player_options.loop = options.loop;
   player_options.channels = options.channels;
+  player_options.image_encoding = logs::ImageEncoding::parse(options.image_encoding);
   for (const std::string& text : options.remap) player_options.remap.insert(logs::parseRemap(text));
 
   const std::string url = options.url.empty() ? core::defaultBusUrl() : options.url;
@@ -217,6 +236,9 @@ void runLogPlay(const LogPlayCommandOptions& options) {
   std::cout << ") to " << bus->url() << "\n";
   for (const auto& [from, to] : player_options.remap) {
     std::cout << "  " << from << " is sent as " << to << "\n";
+  }
+  if (player_options.image_encoding.kind != logs::ImageEncoding::Kind::kAsRecorded) {
+    std::cout << "  images are sent " << player_options.image_encoding.name() << "\n";
   }
   if (!player.damageReport().empty()) {
     std::cerr << "warning: the log is damaged; playing what could be read: "
@@ -282,13 +304,115 @@ void runLogPlay(const LogPlayCommandOptions& options) {
   }
   showStatus(true);
   if (show_status) std::cerr << "\n";
-  std::cout << "nadir log play: sent " << player.eventsSent() << " messages";
+  std::cout << "nadir log play: sent " << player.eventsSent() << " messages, " << player.bytesSent()
+            << " bytes";
+  if (player.imagesReencoded() > 0) {
+    std::cout << " (" << player.imagesReencoded() << " images re-encoded "
+              << player_options.image_encoding.name() << ")";
+  }
   if (player.finished()) {
-    std::cout << ", the log ended\n";
+    std::cout << "; the log ended\n";
   } else {
-    std::cout << ", stopped at " << seconds(player.positionS()) << " s\n";
+    std::cout << "; stopped at " << seconds(player.positionS()) << " s\n";
+  }
+  for (const auto& [channel, bytes] : player.bytesSentByChannel()) {
+    std::cout << "  " << channel << ": " << bytes << " bytes\n";
   }
   if (g_stop_signal != 0) throw CLI::RuntimeError(128 + g_stop_signal);
+}
+
+// "CHANNEL=HZ" -> {CHANNEL, HZ}; throws std::invalid_argument.
+std::pair<std::string, double> parseRate(const std::string& text) {
+  const auto eq = text.find('=');
+  double rate_hz = 0.0;
+  std::size_t used = 0;
+  if (eq != std::string::npos && eq > 0) {
+    try {
+      rate_hz = std::stod(text.substr(eq + 1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+  }
+  if (eq == std::string::npos || eq == 0 || used == 0 || used != text.size() - eq - 1 ||
+      !(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
+    throw std::invalid_argument("a rate is CHANNEL=HZ with HZ > 0, not '" + text + "'");
+  }
+  return {text.substr(0, eq), rate_hz};
+}
+
+void printArrivals(const std::map<std::string, core::ChannelStats>& arrivals) {
+  for (const auto& [channel, stats] : arrivals) {
+    std::cout << "  " << channel << ": " << stats.messages << " messages, " << stats.bytes
+              << " bytes";
+    if (stats.rate_hz > 0.0) {
+      char rate[96];
+      std::snprintf(rate, sizeof(rate), ", %.2f Hz, %lld lost in %lld gaps", stats.rate_hz,
+                    static_cast<long long>(stats.missing), static_cast<long long>(stats.gaps));
+      std::cout << rate;
+    } else {
+      std::cout << ", no steady rate (losses not counted)";
+    }
+    if (stats.out_of_order > 0) std::cout << ", " << stats.out_of_order << " out of order";
+    std::cout << "\n";
+  }
+}
+
+void runLogRecord(const LogRecordCommandOptions& options) {
+  if (!options.force && std::filesystem::exists(options.log)) {
+    throw std::runtime_error(options.log + " already exists; pass --force to replace it");
+  }
+  logs::RecorderOptions recorder_options;
+  recorder_options.channels = options.channels;
+  if (!options.scenario.empty()) {
+    recorder_options.expected_rates_hz =
+        nodes::expectedRates(nodes::loadScenario(options.scenario));
+  }
+  for (const std::string& text : options.rates) {
+    const auto [channel, rate_hz] = parseRate(text);
+    recorder_options.expected_rates_hz[channel] = rate_hz;
+  }
+  const std::string url = options.url.empty() ? core::defaultBusUrl() : options.url;
+  const std::unique_ptr<core::Bus> bus = core::openBus(url);
+  logs::LogRecorder recorder(*bus, options.log, recorder_options);
+  std::cout << "nadir log record: " << bus->url() << " to " << options.log;
+  if (!options.channels.empty()) std::cout << " (channels matching " << options.channels << ")";
+  std::cout << "; Ctrl-C stops" << std::endl;
+
+  const StopSignals stop_signals;
+  const bool show_status = isatty(STDERR_FILENO) != 0;
+  const std::int64_t started = logs::LogPlayer::steadyClockUtime();
+  std::int64_t last_status = started;
+  const char* ended = "stopped";
+  while (g_stop_signal == 0) {
+    bus->handle(std::chrono::milliseconds(100));
+    const std::int64_t now = logs::LogPlayer::steadyClockUtime();
+    if (now - last_status >= 1'000'000) {
+      last_status = now;
+      recorder.flush();
+      if (show_status) {
+        std::cerr << "\r\033[K" << seconds(core::secondsFromUtime(now - started)) << " s  "
+                  << recorder.eventsWritten() << " messages  " << recorder.bytesWritten()
+                  << " bytes  " << core::describeLosses(recorder.arrivals()) << std::flush;
+      }
+    }
+    if (options.duration_s > 0.0 && core::secondsFromUtime(now - started) >= options.duration_s) {
+      ended = "its duration is over";
+      break;
+    }
+    if (options.idle_stop_s > 0.0 && recorder.lastReceiveUtime() > 0 &&
+        core::secondsFromUtime(core::wallClockUtime() - recorder.lastReceiveUtime()) >=
+            options.idle_stop_s) {
+      ended = "the bus went quiet";
+      break;
+    }
+  }
+  recorder.flush();
+  if (show_status) std::cerr << "\n";
+  const auto arrivals = recorder.arrivals();
+  std::cout << "nadir log record: " << ended << "; " << recorder.eventsWritten() << " messages, "
+            << recorder.bytesWritten() << " bytes in " << options.log << "; "
+            << core::describeLosses(arrivals) << "\n";
+  printArrivals(arrivals);
 }
 
 }  // namespace
@@ -338,7 +462,56 @@ void addLogCommands(CLI::App& app) {
   play->add_option("--remap", play_options->remap, "Send channel FROM as TO (FROM=TO, repeatable)");
   play->add_option("--channels", play_options->channels,
                    "Play only channels whose whole name (in the log) matches this regex");
+  play->add_option("--image-encoding", play_options->image_encoding,
+                   "Send images as-recorded, raw, or jpeg[:QUALITY] (re-encoded on the way; "
+                   "default quality 90)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            try {
+              logs::ImageEncoding::parse(text);
+            } catch (const std::invalid_argument& error) {
+              return error.what();
+            }
+            return {};
+          },
+          "ENCODING"));
   play->callback([play_options] { runLogPlay(*play_options); });
+
+  auto record_options = std::make_shared<LogRecordCommandOptions>();
+  CLI::App* record = log->add_subcommand(
+      "record",
+      "Record a bus into an LCM log (as lcm-logger), counting per channel what was lost on the "
+      "way");
+  record->add_option("LOG", record_options->log, "The LCM log to write")->required();
+  record->add_option("--url", record_options->url,
+                     "Bus to record (udpm://, memq://); default $LCM_DEFAULT_URL or LCM's");
+  record->add_option("--channels", record_options->channels,
+                     "Record only channels whose whole name matches this regex");
+  record
+      ->add_option("--rate", record_options->rates,
+                   "A channel's rate, CHANNEL=HZ of message time, to count its losses against "
+                   "(repeatable; other channels have theirs learnt)")
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            try {
+              parseRate(text);
+            } catch (const std::invalid_argument& error) {
+              return error.what();
+            }
+            return {};
+          },
+          "CHANNEL=HZ"));
+  record->add_option("--scenario", record_options->scenario,
+                     "Take the rates of the streams this scenario's nodes publish");
+  record
+      ->add_option("--idle-stop", record_options->idle_stop_s,
+                   "Stop once nothing has arrived for this long, s (after the first message)")
+      ->check(CLI::PositiveNumber);
+  record->add_option("--duration", record_options->duration_s, "Stop after this long, s")
+      ->check(CLI::PositiveNumber);
+  record->add_flag("--force", record_options->force, "Replace LOG if it exists");
+  record->callback([record_options] { runLogRecord(*record_options); });
 }
 
 }  // namespace nadir::cli

@@ -1,5 +1,6 @@
 #include "core/bus.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <utility>
 
@@ -44,7 +45,21 @@ int Bus::handleAvailable() {
 
 std::map<std::string, ChannelStats> Bus::stats() const {
   std::lock_guard lock(stats_mutex_);
-  return {stats_.begin(), stats_.end()};
+  std::map<std::string, ChannelStats> out(stats_.begin(), stats_.end());
+  for (const auto& [channel, gaps] : gaps_) {
+    ChannelStats& stats = out[channel];
+    stats.missing = gaps.missing();
+    stats.gaps = gaps.gaps();
+    stats.out_of_order = gaps.outOfOrder();
+    stats.rate_hz = gaps.rateHz();
+  }
+  return out;
+}
+
+void Bus::expectRate(const std::string& channel, double rate_hz) {
+  std::lock_guard lock(stats_mutex_);
+  expected_rates_[channel] = rate_hz;
+  if (auto it = gaps_.find(channel); it != gaps_.end()) it->second.expectRate(rate_hz);
 }
 
 void Bus::publish(std::string_view channel, const void* data, std::size_t size,
@@ -61,12 +76,24 @@ std::map<std::string, std::int64_t> Bus::sent() const {
   return {sent_.begin(), sent_.end()};
 }
 
-void Bus::countMessage(std::string_view channel, std::size_t size) {
+void Bus::countMessage(std::string_view channel, const void* data, std::size_t size) {
   std::lock_guard lock(stats_mutex_);
   auto it = stats_.find(channel);
   if (it == stats_.end()) it = stats_.emplace(std::string(channel), ChannelStats{}).first;
   ++it->second.messages;
   it->second.bytes += size;
+  const std::optional<std::int64_t> utime =
+      peekUtime(RawMessage{channel, static_cast<const std::uint8_t*>(data), size, 0});
+  if (!utime) return;
+  auto gaps = gaps_.find(channel);
+  if (gaps == gaps_.end()) {
+    const auto rate = expected_rates_.find(channel);
+    gaps = gaps_
+               .emplace(std::string(channel),
+                        StreamGaps(rate == expected_rates_.end() ? 0.0 : rate->second))
+               .first;
+  }
+  gaps->second.add(*utime);
 }
 
 void Bus::countDecodeError(std::string_view channel) {
@@ -74,6 +101,41 @@ void Bus::countDecodeError(std::string_view channel) {
   auto it = stats_.find(channel);
   if (it == stats_.end()) it = stats_.emplace(std::string(channel), ChannelStats{}).first;
   ++it->second.decode_errors;
+}
+
+std::string describeLosses(const std::map<std::string, ChannelStats>& stats,
+                           const std::string& ignore) {
+  std::string lost;
+  int counted = 0;
+  for (const auto& [channel, channel_stats] : stats) {
+    if (channel == ignore || channel_stats.rate_hz <= 0.0) continue;
+    ++counted;
+    if (channel_stats.missing == 0) continue;
+    lost +=
+        (lost.empty() ? "lost " : ", ") + channel + " " + std::to_string(channel_stats.missing) +
+        " of " +
+        std::to_string(static_cast<std::int64_t>(channel_stats.messages) + channel_stats.missing) +
+        " (" + std::to_string(channel_stats.gaps) + (channel_stats.gaps == 1 ? " gap)" : " gaps)");
+  }
+  if (!lost.empty()) return lost;
+  return "nothing lost on " + std::to_string(counted) + (counted == 1 ? " channel" : " channels");
+}
+
+std::string describeArrivals(const std::map<std::string, ChannelStats>& stats,
+                             const std::string& ignore) {
+  std::string text;
+  for (const auto& [channel, channel_stats] : stats) {
+    if (channel == ignore) continue;
+    if (!text.empty()) text += "; ";
+    text += channel + " " + std::to_string(channel_stats.messages);
+    if (channel_stats.rate_hz > 0.0) {
+      char rate[64];
+      std::snprintf(rate, sizeof(rate), " at %.1f Hz, %lld lost", channel_stats.rate_hz,
+                    static_cast<long long>(channel_stats.missing));
+      text += rate;
+    }
+  }
+  return text.empty() ? "nothing" : text;
 }
 
 std::optional<std::int64_t> peekUtime(const RawMessage& message) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/params.h"
+#include "core/stream_gaps.h"
 
 namespace nadir::core {
 
@@ -40,6 +41,13 @@ struct ChannelStats {
   std::uint64_t messages = 0;
   std::uint64_t bytes = 0;
   std::uint64_t decode_errors = 0;
+  // Lost on the way, from the messages' times (core/stream_gaps.h): messages
+  // and places, at rate_hz (given by expectRate or learnt; 0 when unknown or
+  // irregular, and then nothing is counted).
+  std::int64_t missing = 0;
+  std::int64_t gaps = 0;
+  std::int64_t out_of_order = 0;
+  double rate_hz = 0.0;
 };
 
 class Bus;
@@ -92,6 +100,9 @@ class Bus {
 
   // Counters per channel, of every message this bus received.
   std::map<std::string, ChannelStats> stats() const;
+  // The rate a channel's sender keeps, in its messages' time, for counting
+  // what was lost; a channel not named here has its rate learnt.
+  void expectRate(const std::string& channel, double rate_hz);
   // Messages sent through this bus per channel (what a node says it published).
   std::map<std::string, std::int64_t> sent() const;
 
@@ -109,13 +120,15 @@ class Bus {
                     std::int64_t event_utime) = 0;
   virtual void addSubscription(const Handler& handler) = 0;
   virtual void removeSubscription(int id) = 0;
-  void countMessage(std::string_view channel, std::size_t size);
+  void countMessage(std::string_view channel, const void* data, std::size_t size);
 
  private:
   friend class Subscription;
   int next_id_ = 0;
   mutable std::mutex stats_mutex_;
   std::map<std::string, ChannelStats, std::less<>> stats_;
+  std::map<std::string, StreamGaps, std::less<>> gaps_;
+  std::map<std::string, double, std::less<>> expected_rates_;
   std::map<std::string, std::int64_t, std::less<>> sent_;
 };
 
@@ -147,6 +160,17 @@ std::unique_ptr<Bus> openBus(const BusParams& params);
 
 // The URL an empty url resolves to here.
 std::string defaultBusUrl();
+
+// What stats say was lost, for a status line: "nothing lost on 7 channels" or
+// "lost CAMERA_DOWN 3 of 1863 (2 gaps), RANGE 1 of 400 (1 gap)". Channels
+// without a known rate (irregular, or too few messages yet) and ignore are left out.
+std::string describeLosses(const std::map<std::string, ChannelStats>& stats,
+                           const std::string& ignore = {});
+
+// Every channel's messages in one line: "CAMERA_DOWN 1860 at 31.0 Hz, 0 lost;
+// VO_COMMAND 2" (no rate: irregular, or too few to learn one).
+std::string describeArrivals(const std::map<std::string, ChannelStats>& stats,
+                             const std::string& ignore = {});
 
 // Every nadir message starts with int64 utime right after LCM's 8-byte
 // fingerprint; this reads it without knowing the type (nothing if too short).

@@ -80,7 +80,7 @@ void LcmBus::onMessage(const lcm_recv_buf_t* buffer, const char* channel, void* 
 }
 
 void LcmBus::onAnyMessage(const lcm_recv_buf_t* buffer, const char* channel, void* user) {
-  static_cast<LcmBus*>(user)->countMessage(channel, buffer->data_size);
+  static_cast<LcmBus*>(user)->countMessage(channel, buffer->data, buffer->data_size);
 }
 
 }  // namespace nadir::core

@@ -96,7 +96,7 @@ void LogBus::send(std::string_view channel, const void* data, std::size_t size,
                    " is open for reading");
   }
   writer_->write(event_utime, std::string(channel), data, size);
-  countMessage(channel, size);
+  countMessage(channel, data, size);
 }
 
 bool LogBus::handle(std::chrono::milliseconds /*timeout*/) {
@@ -119,7 +119,7 @@ bool LogBus::handle(std::chrono::milliseconds /*timeout*/) {
                                                     offset_us / options_.speed)));
   }
   now_utime_ = event->timestamp_utime;
-  countMessage(event->channel, event->data.size());
+  countMessage(event->channel, event->data.data(), event->data.size());
   const RawMessage raw{event->channel, event->data.data(), event->data.size(),
                        event->timestamp_utime};
   // Handlers may subscribe or unsubscribe from inside a callback: iterate by

@@ -1041,4 +1041,14 @@ std::string typeName(const void* data, std::size_t size) {
   return {};
 }
 
+bool isJpegImage(const void* data, std::size_t size) {
+  // image_t: fingerprint, utime (int64), width, height, row_stride, pixelformat (int32s).
+  constexpr std::size_t kPixelFormatOffset = 8 + 8 + 3 * 4;
+  if (!isType<Image>(data, size) || size < kPixelFormatOffset + 4) return false;
+  const auto* bytes = static_cast<const std::uint8_t*>(data) + kPixelFormatOffset;
+  std::uint32_t format = 0;
+  for (int i = 0; i < 4; ++i) format = (format << 8) | bytes[i];
+  return static_cast<std::int32_t>(format) == nadir::image_t::PIXEL_FORMAT_MJPEG;
+}
+
 }  // namespace nadir::msg

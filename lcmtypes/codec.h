@@ -67,6 +67,10 @@ T decode(const Bytes& bytes) {
 template <class T>
 bool isType(const void* data, std::size_t size);
 
+// True when the bytes are an image_t whose pixels are JPEG (MJPEG), read from
+// its header without decoding the pixels.
+bool isJpegImage(const void* data, std::size_t size);
+
 // The LCM type name the fingerprint says ("pose_t"), or empty for none of nadir's.
 std::string typeName(const void* data, std::size_t size);
 

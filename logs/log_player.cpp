@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/clock.h"
+#include "lcmtypes/codec.h"
 #include "logs/channel_filter.h"
 
 namespace nadir::logs {
@@ -26,6 +27,46 @@ void checkSpeed(double speed) {
 }
 
 }  // namespace
+
+ImageEncoding ImageEncoding::parse(const std::string& text) {
+  ImageEncoding encoding;
+  if (text == "as-recorded") return encoding;
+  if (text == "raw") {
+    encoding.kind = Kind::kRaw;
+    return encoding;
+  }
+  if (text == "jpeg" || text.rfind("jpeg:", 0) == 0) {
+    encoding.kind = Kind::kJpeg;
+    if (text == "jpeg") return encoding;
+    const std::string quality = text.substr(5);
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(quality, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (quality.empty() || used != quality.size() || value < 1 || value > 100) {
+      throw std::invalid_argument("'" + text + "': a JPEG quality is a whole number 1-100");
+    }
+    encoding.jpeg_quality = value;
+    return encoding;
+  }
+  throw std::invalid_argument("an image encoding is as-recorded, raw, jpeg or jpeg:QUALITY, not '" +
+                              text + "'");
+}
+
+std::string ImageEncoding::name() const {
+  switch (kind) {
+    case Kind::kRaw:
+      return "raw";
+    case Kind::kJpeg:
+      return "jpeg:" + std::to_string(jpeg_quality);
+    case Kind::kAsRecorded:
+      break;
+  }
+  return "as-recorded";
+}
 
 std::pair<std::string, std::string> parseRemap(const std::string& text) {
   const auto eq = text.find('=');
@@ -104,14 +145,39 @@ int LogPlayer::sendUpTo(std::int64_t log_utime) {
       throw core::LogError(index_.path + " changed while playing: no event at byte " +
                            std::to_string(entry.offset) + " any more");
     }
-    bus_.publish(channel_out_[static_cast<std::size_t>(entry.channel)], event->data.data(),
-                 event->data.size(), event->timestamp_utime);
+    send(channel_out_[static_cast<std::size_t>(entry.channel)], *event);
     ++cursor_;
     ++sent;
     ++events_sent_;
   }
   position_utime_ = std::max(position_utime_, log_utime);
   return sent;
+}
+
+void LogPlayer::send(const std::string& channel, const core::LogEvent& event) {
+  const ImageEncoding& encoding = options_.image_encoding;
+  msg::Bytes reencoded;
+  if (encoding.kind != ImageEncoding::Kind::kAsRecorded &&
+      msg::isType<msg::Image>(event.data.data(), event.data.size())) {
+    // An image that does not decode goes out as it was: the receiver counts it.
+    try {
+      msg::Image image = msg::decode<msg::Image>(event.data.data(), event.data.size());
+      const bool is_jpeg = msg::isJpegImage(event.data.data(), event.data.size());
+      const bool want_jpeg = encoding.kind == ImageEncoding::Kind::kJpeg;
+      if (is_jpeg != want_jpeg) {
+        image.jpeg_quality = want_jpeg ? encoding.jpeg_quality : 0;
+        reencoded = msg::encode(image);
+        ++images_reencoded_;
+      }
+    } catch (const std::exception&) {
+      reencoded.clear();
+    }
+  }
+  const std::uint8_t* data = reencoded.empty() ? event.data.data() : reencoded.data();
+  const std::size_t size = reencoded.empty() ? event.data.size() : reencoded.size();
+  bus_.publish(channel, data, size, event.timestamp_utime);
+  bytes_sent_ += static_cast<std::int64_t>(size);
+  channel_bytes_[channel] += static_cast<std::int64_t>(size);
 }
 
 int LogPlayer::update() {

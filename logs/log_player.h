@@ -25,6 +25,18 @@
 
 namespace nadir::logs {
 
+// How camera images (image_t) go out: as the log holds them, or each one
+// re-encoded raw (GRAY/RGB) or as JPEG of a quality.
+struct ImageEncoding {
+  enum class Kind { kAsRecorded, kRaw, kJpeg };
+  Kind kind = Kind::kAsRecorded;
+  int jpeg_quality = 90;  // 1-100, for kJpeg
+
+  // "as-recorded", "raw", "jpeg" or "jpeg:Q"; throws std::invalid_argument.
+  static ImageEncoding parse(const std::string& text);
+  std::string name() const;
+};
+
 struct PlayerOptions {
   double speed = 1.0;    // times real time, > 0
   double start_s = 0.0;  // where to begin (and loop back to), s after the log's first event
@@ -34,6 +46,7 @@ struct PlayerOptions {
   // Send only channels (as named in the log) that fully match this POSIX
   // extended regex; empty: every channel.
   std::string channels{};
+  ImageEncoding image_encoding{};
 };
 
 // Parses "FROM=TO" into {FROM, TO}; throws std::invalid_argument if either is empty.
@@ -85,6 +98,11 @@ class LogPlayer {
   std::optional<std::int64_t> microsUntilNextEvent() const;
 
   std::int64_t eventsSent() const { return events_sent_; }
+  // Bytes put on the bus (after re-encoding images), in all and by channel as sent.
+  std::int64_t bytesSent() const { return bytes_sent_; }
+  const std::map<std::string, std::int64_t>& bytesSentByChannel() const { return channel_bytes_; }
+  // Images re-encoded, and those that were not images after all (sent as they were).
+  std::int64_t imagesReencoded() const { return images_reencoded_; }
   int loops() const { return loops_; }
   // Events (of the whole log) and the ones the channel filter selects.
   std::int64_t events() const { return static_cast<std::int64_t>(index_.events.size()); }
@@ -97,6 +115,7 @@ class LogPlayer {
 
  private:
   int sendUpTo(std::int64_t log_utime);
+  void send(const std::string& channel, const core::LogEvent& event);
   void anchor();
   std::size_t firstSelectedAtOrAfter(std::int64_t log_utime) const;
   std::int64_t selectedTime(std::size_t i) const;
@@ -119,6 +138,9 @@ class LogPlayer {
   double speed_ = 1.0;
   bool paused_ = false;
   std::int64_t events_sent_ = 0;
+  std::int64_t bytes_sent_ = 0;
+  std::int64_t images_reencoded_ = 0;
+  std::map<std::string, std::int64_t> channel_bytes_;
   int loops_ = 0;
 };
 

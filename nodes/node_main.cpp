@@ -72,7 +72,9 @@ class Heartbeat {
     msg::publish(
         bus_, channel_,
         msg::Heartbeat{core::wallClockUtime(), node_, static_cast<std::int32_t>(::getpid()),
-                       sequence_++, done, running.summary(), std::move(sent)});
+                       sequence_++, done,
+                       running.summary() + "; " + core::describeLosses(bus_.stats(), channel_),
+                       std::move(sent)});
   }
 
   core::Bus& bus_;
@@ -112,6 +114,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
   try {
     ProcessParams params(node_entry.defaultParams());
     std::string source;
+    std::map<std::string, double> expected_rates_hz;  // of the scenario's streams
     if (!config_path.empty()) {
       core::applyYamlFile(config_path, [&params](core::ParamVisitor& v) { params.visit(v); });
       core::applyAssignments(params, overrides);
@@ -121,11 +124,13 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
       params.bus = scenario.bus;
       params.node = node_entry.fromScenario(scenario);
       source = scenario_name;
+      expected_rates_hz = expectedRates(scenario);
     }
     std::cout << info.program << " parameters (" << source << "):\n"
               << core::formatParamsOf(params.node) << std::flush;
 
     auto bus = core::openBus(params.bus);
+    for (const auto& [channel, rate_hz] : expected_rates_hz) bus->expectRate(channel, rate_hz);
     const std::unique_ptr<Node> node = node_entry.start(*bus, params.node);
     if (const std::string about = node->describe(); !about.empty()) std::cout << about << "\n";
     std::cout << "bus: " << bus->url() << std::endl;
@@ -141,7 +146,9 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
     }
     if (live) heartbeat.last(*node);
     std::cout << info.program << ": " << (g_stop ? "stopped" : "done") << "; " << node->summary()
-              << std::endl;
+              << "\n"
+              << info.program << ": received "
+              << core::describeArrivals(bus->stats(), params.bus.heartbeat_channel) << std::endl;
   } catch (const std::exception& error) {
     std::cerr << info.program << ": error: " << error.what() << std::endl;
     return 1;

@@ -43,4 +43,15 @@ const Entry& entry(std::string_view name) {
   throw std::invalid_argument("no node named '" + std::string(name) + "' (nodes: " + names + ")");
 }
 
+std::map<std::string, double> expectedRates(const ScenarioParams& scenario) {
+  std::map<std::string, double> rates;
+  for (const auto& node : registry()) {
+    if (!node->enabled(scenario)) continue;
+    for (const Stream& stream : node->streams(node->fromScenario(scenario))) {
+      if (stream.rate_hz > 0.0) rates[stream.channel] = stream.rate_hz;
+    }
+  }
+  return rates;
+}
+
 }  // namespace nadir::nodes

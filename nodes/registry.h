@@ -5,6 +5,7 @@
 // under nodes/ with an entry there, and one line in registry.cpp.
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -144,5 +145,9 @@ const std::vector<std::unique_ptr<Entry>>& registry();
 
 // The entry named `name`; throws std::invalid_argument listing the names.
 const Entry& entry(std::string_view name);
+
+// The rate of every stream with one that the nodes a scenario runs publish,
+// by channel (Hz of sim time): what a receiver counts its losses against.
+std::map<std::string, double> expectedRates(const ScenarioParams& scenario);
 
 }  // namespace nadir::nodes

@@ -198,9 +198,9 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     }
     launched.push_back({entry.get(), std::make_unique<ChildProcess>(entry->info().program, argv,
                                                                     nodeLog(entry->info().name))});
-    for (const nodes::Stream& stream : entry->streams(entry->fromScenario(scenario))) {
-      if (stream.rate_hz > 0.0) channels[stream.channel].expected_hz = stream.rate_hz;
-    }
+  }
+  for (const auto& [channel, rate_hz] : nodes::expectedRates(scenario)) {
+    channels[channel].expected_hz = rate_hz;
   }
   const auto isSimulator = [](const LaunchedNode& node) {
     return node.entry->info().role == nodes::EntryInfo::Role::kSimulator;

@@ -3,12 +3,17 @@
 
 #include <lcm/eventlog.h>
 
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include "core/log_bus.h"
+#include "lcmtypes/codec.h"
 #include "logs/log_player.h"
 #include "tests/logs/log_test_util.h"
 
@@ -230,6 +235,65 @@ TEST_F(LogPlayerTest, PlaysIntoALogFileThatLcmReads) {
   }
   lcm_eventlog_destroy(log);
   EXPECT_EQ(events, (std::vector<std::string>{"A@80", "B@85", "A@90", "B@95"}));
+}
+
+// Images re-encoded on the way: a raw gray frame goes out as JPEG of the
+// quality asked (decoding to within JPEG's error of the pixels) or as it was;
+// other messages go out unchanged; the bytes sent are what the bus carried.
+TEST_F(LogPlayerTest, ReencodesImagesAndCountsTheBytesSent) {
+  cv::Mat pixels(48, 64, CV_8UC1);
+  for (int y = 0; y < pixels.rows; ++y) {
+    for (int x = 0; x < pixels.cols; ++x)
+      pixels.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(2 * x + y);
+  }
+  const msg::Bytes raw = msg::encode(msg::Image{kT0, pixels, 0, {}});
+  const std::string path = test::tempPath("play_images.lcmlog");
+  test::writeLog(path, {{kT0, "CAMERA", raw}, {kT0, "A", test::payload(20, 0)}});
+
+  for (const char* encoding : {"jpeg:75", "raw", "as-recorded"}) {
+    SCOPED_TRACE(encoding);
+    auto bus = core::openBus("memq://");
+    std::map<std::string, std::int64_t> received_bytes;
+    std::optional<msg::Image> image;
+    bool jpeg = false;
+    auto subscription = bus->subscribe(".*", [&](const core::RawMessage& message) {
+      received_bytes[std::string(message.channel)] += static_cast<std::int64_t>(message.size);
+      if (message.channel != "CAMERA") return;
+      jpeg = msg::isJpegImage(message.data, message.size);
+      image = msg::decode<msg::Image>(message.data, message.size);
+    });
+    LogPlayer player(path, *bus, {.image_encoding = ImageEncoding::parse(encoding)}, clock());
+    player.stepTo(kT0);
+    bus->handleAvailable();
+    ASSERT_TRUE(image.has_value());
+    EXPECT_EQ(jpeg, std::string(encoding) == "jpeg:75");
+    EXPECT_EQ(player.imagesReencoded(), jpeg ? 1 : 0);
+    EXPECT_EQ(image->utime, kT0);
+    EXPECT_LE(cv::norm(image->pixels, pixels, cv::NORM_INF), jpeg ? 8.0 : 0.0);
+    EXPECT_EQ(received_bytes.at("A"), 20);
+    EXPECT_EQ(player.bytesSentByChannel(), received_bytes);
+    EXPECT_EQ(player.bytesSent(), received_bytes.at("A") + received_bytes.at("CAMERA"));
+    if (jpeg) {
+      EXPECT_LT(received_bytes.at("CAMERA"), static_cast<std::int64_t>(raw.size()));
+    } else {
+      EXPECT_EQ(received_bytes.at("CAMERA"), static_cast<std::int64_t>(raw.size()));
+    }
+  }
+}
+
+// An encoding the player does not know, or a quality out of 1-100, is named.
+TEST(ImageEncoding, ParsesWhatItKnowsAndNamesWhatItDoesNot) {
+  EXPECT_EQ(ImageEncoding::parse("jpeg").jpeg_quality, 90);
+  EXPECT_EQ(ImageEncoding::parse("jpeg:55").name(), "jpeg:55");
+  EXPECT_EQ(ImageEncoding::parse("raw").kind, ImageEncoding::Kind::kRaw);
+  for (const char* bad : {"png", "jpeg:0", "jpeg:101", "jpeg:9x", "jpeg:", ""}) {
+    try {
+      ImageEncoding::parse(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(bad), std::string::npos) << error.what();
+    }
+  }
 }
 
 }  // namespace

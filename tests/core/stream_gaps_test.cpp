@@ -1,0 +1,115 @@
+// StreamGaps: messages lost on the way, counted from the messages' own times.
+#include "core/stream_gaps.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/bus.h"
+
+namespace nadir::core {
+namespace {
+
+// 31 frames/s on a 400 Hz sim clock: frames at the first 2.5 ms step at or
+// after k / 31 s, so intervals of 30 or 32.5 ms, never exactly 32.26.
+std::int64_t frameUtime(int k) {
+  const double t_us = static_cast<double>(k) * 1e6 / 31.0;
+  const auto steps = static_cast<std::int64_t>(std::ceil(t_us / 2500.0 - 1e-9));
+  return steps * 2500;
+}
+
+// Frames 0..99 at a given rate minus 10, 11, 12 and 50: 4 lost in 2 places.
+TEST(StreamGaps, CountsLostFramesAtAGivenRate) {
+  StreamGaps gaps(31.0);
+  for (int k = 0; k < 100; ++k) {
+    if (k == 10 || k == 11 || k == 12 || k == 50) continue;
+    gaps.add(frameUtime(k));
+  }
+  EXPECT_EQ(gaps.received(), 96);
+  EXPECT_EQ(gaps.missing(), 4);
+  EXPECT_EQ(gaps.gaps(), 2);
+  EXPECT_EQ(gaps.outOfOrder(), 0);
+  EXPECT_DOUBLE_EQ(gaps.rateHz(), 31.0);
+  EXPECT_FALSE(gaps.learnt());
+}
+
+// The same stream with no rate given: learnt from the first 16 intervals
+// (one of them a gap, counted once the rate is known).
+TEST(StreamGaps, LearnsTheRateAndCountsTheGapsItLearntFrom) {
+  StreamGaps gaps;
+  for (int k = 0; k < 100; ++k) {
+    if (k == 3 || k == 60 || k == 61) continue;
+    gaps.add(frameUtime(k));
+  }
+  EXPECT_TRUE(gaps.learnt());
+  EXPECT_FALSE(gaps.irregular());
+  // The median interval of 30 / 32.5 ms steps: one of the two.
+  EXPECT_TRUE(gaps.rateHz() == 1e6 / 32500.0 || gaps.rateHz() == 1e6 / 30000.0) << gaps.rateHz();
+  EXPECT_EQ(gaps.missing(), 3);
+  EXPECT_EQ(gaps.gaps(), 2);
+}
+
+// Nothing is counted before the rate is known: 16 messages make 15 intervals.
+TEST(StreamGaps, CountsNothingWhileLearning) {
+  StreamGaps gaps;
+  for (int k = 0; k < 16; ++k) gaps.add(k * 2 * 10000);  // every other one of 100 Hz
+  EXPECT_DOUBLE_EQ(gaps.rateHz(), 0.0);
+  EXPECT_EQ(gaps.missing(), 0);
+}
+
+// Intervals with no common beat (commands sent by hand) are not a stream.
+TEST(StreamGaps, IrregularTimesAreNotCounted) {
+  StreamGaps gaps;
+  const std::vector<std::int64_t> times = {0,       130000,  170000,  510000,  530000,  990000,
+                                           1400000, 1410000, 1777000, 2100000, 2333000, 2900000,
+                                           3050000, 3120000, 3700000, 3790000, 4400000, 5000000};
+  for (const std::int64_t t : times) gaps.add(t);
+  EXPECT_TRUE(gaps.irregular());
+  EXPECT_DOUBLE_EQ(gaps.rateHz(), 0.0);
+  EXPECT_EQ(gaps.missing(), 0);
+}
+
+// A log played in a loop starts again from its beginning: a new start, not a
+// loss; a message one period late is out of order and not counted twice.
+TEST(StreamGaps, ALoopIsANewStartAndALateMessageIsOutOfOrder) {
+  StreamGaps gaps(100.0);
+  for (int loop = 0; loop < 2; ++loop) {
+    for (int k = 0; k < 50; ++k) gaps.add(k * 10000);
+  }
+  EXPECT_EQ(gaps.missing(), 0);
+  EXPECT_EQ(gaps.outOfOrder(), 1);
+  // 0, 10, 30, 20, 40 ms: 20 comes late; one interval of two periods (10 -> 30).
+  StreamGaps late(100.0);
+  for (const std::int64_t t : {0, 10000, 30000, 20000, 40000}) late.add(t);
+  EXPECT_EQ(late.outOfOrder(), 1);
+  EXPECT_EQ(late.missing(), 1);
+}
+
+// The bus counts gaps per channel from every message it receives, at the
+// rate it was told or a learnt one.
+TEST(StreamGaps, TheBusCountsEachChannelsGaps) {
+  auto bus = openBus("memq://");
+  bus->expectRate("CAMERA", 31.0);
+  const auto send = [&](const std::string& channel, std::int64_t utime) {
+    std::vector<std::uint8_t> bytes(24, 0);
+    for (int i = 0; i < 8; ++i) bytes[8 + i] = static_cast<std::uint8_t>(utime >> (56 - 8 * i));
+    bus->publish(channel, bytes.data(), bytes.size(), utime);
+  };
+  for (int k = 0; k < 40; ++k) {
+    if (k != 20) send("CAMERA", frameUtime(k));
+    if (k != 30 && k != 31) send("RANGE", k * 20000);
+  }
+  bus->handleAvailable();
+  const auto stats = bus->stats();
+  EXPECT_EQ(stats.at("CAMERA").messages, 39u);
+  EXPECT_EQ(stats.at("CAMERA").missing, 1);
+  EXPECT_DOUBLE_EQ(stats.at("CAMERA").rate_hz, 31.0);
+  EXPECT_EQ(stats.at("RANGE").missing, 2);
+  EXPECT_EQ(stats.at("RANGE").gaps, 1);
+  EXPECT_DOUBLE_EQ(stats.at("RANGE").rate_hz, 50.0);
+}
+
+}  // namespace
+}  // namespace nadir::core
