@@ -22,6 +22,7 @@ void addSnapshotCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
 void addRunCommand(CLI::App& app);
 void addLaunchCommand(CLI::App& app);
+void addBusCommands(CLI::App& app);
 void addSweepCommand(CLI::App& app);
 void addLogCommands(CLI::App& app);
 void addEvalCommand(CLI::App& app);

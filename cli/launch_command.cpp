@@ -30,6 +30,16 @@ void addLaunchCommand(CLI::App& app) {
                       "folder for the node logs and the recording (default out/<scenario>-live)");
   command->add_option("--set", options->overrides, "override a parameter: key=value (repeatable)");
   command->add_flag("--force", options->force, "replace an earlier launch in the output folder");
+  command
+      ->add_option("--hosts", options->hosts_file,
+                   "a hosts file: the hosts, the command prefix that reaches each, and the "
+                   "node each runs (docs/running.md)")
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--bus-check-timeout", options->bus_check_timeout_s,
+                   "with --hosts: how long the bus may take to join every host, s")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   command->add_option("--report-period", options->report_period_s, "seconds between reports")
       ->capture_default_str()
       ->check(CLI::Range(0.2, 600.0));

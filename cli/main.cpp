@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   nadir::cli::addExportCommand(app);
   nadir::cli::addRunCommand(app);
   nadir::cli::addLaunchCommand(app);
+  nadir::cli::addBusCommands(app);
   nadir::cli::addSweepCommand(app);
   nadir::cli::addLogCommands(app);
   nadir::cli::addEvalCommand(app);

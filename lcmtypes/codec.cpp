@@ -14,6 +14,7 @@
 #include "nadir/attitude_t.hpp"
 #include "nadir/baro_t.hpp"
 #include "nadir/body_rates_t.hpp"
+#include "nadir/bus_check_t.hpp"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/camera_info_v1_t.hpp"
 #include "nadir/drive_command_t.hpp"
@@ -326,6 +327,10 @@ template <>
 struct LcmOf<Heartbeat> {
   using type = nadir::heartbeat_t;
 };
+template <>
+struct LcmOf<BusCheck> {
+  using type = nadir::bus_check_t;
+};
 
 }  // namespace
 
@@ -602,6 +607,17 @@ Bytes encode(const Heartbeat& message) {
     out.messages_sent.push_back(count);
   }
   out.num_channels = static_cast<std::int32_t>(out.channels.size());
+  return toBytes(out);
+}
+
+Bytes encode(const BusCheck& message) {
+  nadir::bus_check_t out{};
+  out.utime = message.utime;
+  out.launch_id = message.launch_id;
+  out.host = message.host;
+  out.pid = message.pid;
+  out.heard.assign(message.heard.begin(), message.heard.end());
+  out.num_heard = static_cast<std::int32_t>(out.heard.size());
   return toBytes(out);
 }
 
@@ -984,6 +1000,12 @@ Heartbeat decode<Heartbeat>(const void* data, std::size_t size) {
   return out;
 }
 
+template <>
+BusCheck decode<BusCheck>(const void* data, std::size_t size) {
+  const auto in = fromBytes<nadir::bus_check_t>(data, size);
+  return {in.utime, in.launch_id, in.host, in.pid, {in.heard.begin(), in.heard.end()}};
+}
+
 // ---------------------------------------------------------------- types
 
 template <class T>
@@ -1023,6 +1045,7 @@ NADIR_MSG_TYPE(GatePattern)
 NADIR_MSG_TYPE(DriveCommand)
 NADIR_MSG_TYPE(WaypointReached)
 NADIR_MSG_TYPE(Heartbeat)
+NADIR_MSG_TYPE(BusCheck)
 #undef NADIR_MSG_TYPE
 
 std::string typeName(const void* data, std::size_t size) {
@@ -1033,7 +1056,7 @@ std::string typeName(const void* data, std::size_t size) {
                  nadir::camera_info_v1_t, nadir::image_t, nadir::vo_estimate_t, nadir::nav_state_t,
                  nadir::ppa_odometry_t, nadir::target_detection_t, nadir::vo_command_t,
                  nadir::gate_pattern_t, nadir::drive_command_t, nadir::waypoint_reached_t,
-                 nadir::heartbeat_t>();
+                 nadir::heartbeat_t, nadir::bus_check_t>();
   const std::int64_t hash = fingerprintOf(data, size);
   for (const KnownType& type : kTypes) {
     if (type.hash == hash) return type.name;

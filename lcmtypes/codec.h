@@ -54,6 +54,7 @@ Bytes encode(const GatePattern& message);
 Bytes encode(const DriveCommand& message);
 Bytes encode(const WaypointReached& message);
 Bytes encode(const Heartbeat& message);
+Bytes encode(const BusCheck& message);
 
 template <class T>
 T decode(const void* data, std::size_t size);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -271,6 +272,15 @@ struct Heartbeat {
   bool done = false;                         // the last one, as the node stops
   std::string summary;                       // what the node has done so far, one line
   std::map<std::string, std::int64_t> sent;  // messages published so far, by channel
+};
+
+// bus_check_t: one host's word in nadir launch's check of the bus.
+struct BusCheck {
+  std::int64_t utime = 0;      // wall clock, us since the Unix epoch
+  std::int64_t launch_id = 0;  // the launch it belongs to
+  std::string host;
+  std::int32_t pid = 0;
+  std::set<std::string> heard;  // the hosts it has heard
 };
 
 }  // namespace nadir::msg

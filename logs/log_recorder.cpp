@@ -21,7 +21,10 @@ LogRecorder::LogRecorder(core::Bus& bus, const std::string& path, RecorderOption
         message.recv_utime > 0 ? message.recv_utime : core::wallClockUtime();
     writer_.write(receive_utime, channel, message.data, message.size);
     bytes_ += static_cast<std::int64_t>(message.size);
-    if (channel != heartbeat_channel_) last_receive_utime_ = receive_utime;
+    // LCM's own self test is sent when a bus opens: no sign of data either.
+    if (channel != heartbeat_channel_ && channel != "LCM_SELF_TEST") {
+      last_receive_utime_ = receive_utime;
+    }
   });
 }
 

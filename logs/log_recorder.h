@@ -33,7 +33,8 @@ class LogRecorder {
 
   std::int64_t eventsWritten() const { return writer_.eventsWritten(); }
   std::int64_t bytesWritten() const { return bytes_; }
-  // The wall time of the last message recorded, heartbeats aside (0 before the first).
+  // The wall time of the last message recorded, heartbeats and LCM's self
+  // test aside (0 before the first).
   std::int64_t lastReceiveUtime() const { return last_receive_utime_; }
   // What arrived by channel, with what was lost (the bus's counters, of the
   // recorded channels only, heartbeats aside).

@@ -136,6 +136,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
     std::cout << "bus: " << bus->url() << std::endl;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
+    std::signal(SIGHUP, onSignal);  // a remote node whose ssh went away
     // Not into a log file: its events are in message time, a heartbeat's is wall time.
     const bool live = bus->url().rfind("file://", 0) != 0;
     Heartbeat heartbeat(*bus, params.bus.heartbeat_channel, info.name);

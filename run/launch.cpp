@@ -10,6 +10,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <random>
+#include <set>
 #include <stdexcept>
 
 #include "core/bus.h"
@@ -20,6 +22,8 @@
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
 #include "nodes/sim/simulator.h"
+#include "run/bus_check.h"
+#include "run/launch_hosts.h"
 #include "run/process.h"
 #include "run/run.h"
 #include "terrain/world_factory.h"
@@ -114,13 +118,96 @@ std::map<std::string, std::pair<std::int64_t, std::int64_t>> missingFromRecordin
 struct LaunchedNode {
   const nodes::Entry* entry = nullptr;
   std::unique_ptr<ChildProcess> process;
+  std::string host;
 };
+
+// A simulator on the bus that is not this launch's, seen before this one starts.
+struct ForeignSimulator {
+  std::optional<std::string> seen;  // what gave it away
+
+  void refuseIfSeen(const std::string& url) const {
+    if (!seen) return;
+    throw std::runtime_error(
+        "another simulator is flying on " + url + " (" + *seen +
+        "): two flights on one bus mix their truths. Stop it, or give this launch a bus of its "
+        "own (--set bus.url=udpm://239.255.76.67:7668?ttl=0, another port)");
+  }
+};
+
+// Whether url sends nothing off this machine (udpm with ttl=0, or memq).
+bool staysOnThisHost(const std::string& url) {
+  if (url.rfind("memq://", 0) == 0) return true;
+  if (url.rfind("udpm://", 0) != 0) return false;
+  const auto ttl = url.find("ttl=");
+  return ttl == std::string::npos || url.compare(ttl, 5, "ttl=0") == 0;
+}
+
+// The bus joins every host in use: a checker on each, and this launch, until
+// each has heard every other (run/bus_check.h). Returns an empty string, or
+// what failed.
+std::string checkBusReachesHosts(core::Bus& bus, const LaunchHosts& hosts,
+                                 const std::set<std::string>& used, const std::string& url,
+                                 const std::string& bin_dir, const fs::path& out_path,
+                                 double timeout_s, const std::atomic<bool>& stop,
+                                 std::ostream& out) {
+  std::random_device random;
+  const std::int64_t launch_id =
+      static_cast<std::int64_t>((static_cast<std::uint64_t>(random()) << 31) ^ random()) &
+      0x7fffffffffffffff;
+  std::set<std::string> everyone = used;
+  everyone.insert("launch");
+  std::string names;
+  for (const std::string& name : everyone) names += (names.empty() ? "" : ",") + name;
+  std::vector<std::unique_ptr<ChildProcess>> checkers;
+  for (const std::string& host : used) {
+    const std::vector<std::string> argv = {
+        programPath(bin_dir, "nadir"), "bus",    "check", "--url",   url,   "--launch-id",
+        std::to_string(launch_id),     "--host", host,    "--hosts", names, "--timeout",
+        std::to_string(timeout_s)};
+    checkers.push_back(std::make_unique<ChildProcess>(
+        "bus check on " + host, hosts.command(hosts.host(host), argv, bin_dir),
+        (out_path / ("bus-check-" + host + ".log")).string()));
+    checkers.back()->start();
+  }
+  BusCheck check(bus, launch_id, "launch", everyone);
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  std::string problem;
+  while (!check.complete() && problem.empty()) {
+    if (stop) problem = "stopped";
+    if (Clock::now() > deadline) problem = "timed out";
+    for (const auto& checker : checkers) {
+      if (!checker->running() && checker->exitStatus() != 0) {
+        problem = checker->name() + " failed (" + checker->describeExit() + "); see " +
+                  checker->logPath();
+      }
+    }
+    check.beatIfDue();
+    bus.handle(std::chrono::milliseconds(20));
+  }
+  // The checkers say they are done once everyone has heard them say so.
+  const auto linger_deadline = Clock::now() + std::chrono::seconds(5);
+  while (problem.empty() && Clock::now() < linger_deadline &&
+         std::any_of(checkers.begin(), checkers.end(), [](auto& c) { return c->running(); })) {
+    check.beatIfDue();
+    bus.handle(std::chrono::milliseconds(20));
+  }
+  for (const auto& checker : checkers) checker->stop(1.0);
+  if (!problem.empty()) {
+    std::string missing;
+    for (const std::string& link : check.missingLinks()) missing += "\n  " + link;
+    return "the bus does not join every host (" + problem + " after " +
+           std::to_string(static_cast<int>(timeout_s)) + " s):" + missing;
+  }
+  out << "launch: the bus joins every host (" << names << ")\n";
+  return {};
+}
 
 // Every channel's rate in the last window against what the scenario should
 // produce, the VO nodes' status, and what each node's heartbeat says.
 void printHealth(std::ostream& out, double elapsed_s, double window_s, double speed,
                  std::map<std::string, ChannelHealth>& channels,
-                 const std::map<std::string, NodeReport>& heartbeats) {
+                 const std::map<std::string, NodeReport>& heartbeats,
+                 const std::map<std::string, std::vector<std::string>>& nodes_by_host) {
   char line[256];
   std::snprintf(line, sizeof(line), "launch: %.0f s", elapsed_s);
   out << line << "\n";
@@ -140,8 +227,14 @@ void printHealth(std::ostream& out, double elapsed_s, double window_s, double sp
     out << "\n";
     health.window = 0;
   }
-  for (const auto& [node, report] : heartbeats) {
-    out << "  " << node << ": " << report.summary << "\n";
+  for (const auto& [host, nodes_there] : nodes_by_host) {
+    if (nodes_by_host.size() > 1) out << "  host " << host << ":\n";
+    const std::string indent = nodes_by_host.size() > 1 ? "    " : "  ";
+    for (const std::string& node : nodes_there) {
+      const auto report = heartbeats.find(node);
+      out << indent << node << ": "
+          << (report == heartbeats.end() ? "no heartbeat yet" : report->second.summary) << "\n";
+    }
   }
   out.flush();
 }
@@ -176,6 +269,21 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   writeEffectiveScenario(out_dir, "nadir launch " + options.scenario, scenario);
   const std::string bin_dir = options.bin_dir.empty() ? selfDirectory() : options.bin_dir;
   const std::string url = scenario.bus.resolvedUrl();
+  std::vector<std::string> node_names;
+  for (const auto& entry : nodes::registry()) node_names.push_back(entry->info().name);
+  const LaunchHosts hosts =
+      options.hosts_file.empty() ? localHosts() : loadLaunchHosts(options.hosts_file, node_names);
+  std::set<std::string> used_hosts = {hosts.hostOf(kLoggerNode).name};
+  for (const auto& entry : nodes::registry()) {
+    if (entry->enabled(scenario)) used_hosts.insert(hosts.hostOf(entry->info().name).name);
+  }
+  const bool several_hosts = !options.hosts_file.empty();
+  if (several_hosts && used_hosts.size() > 1 && staysOnThisHost(url)) {
+    throw std::runtime_error("the nodes are on " + std::to_string(used_hosts.size()) +
+                             " hosts but the bus " + url +
+                             " stays on each (ttl=0); give it ttl=1: --set "
+                             "bus.url=udpm://239.255.76.67:7667?ttl=1");
+  }
   const auto nodeLog = [&](const std::string& name) {
     return (out_path / (name + ".log")).string();
   };
@@ -183,9 +291,12 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // One process per node the scenario runs, each given the scenario and overrides;
   // the simulator starts once the others are up, and the health report expects
   // what the nodes' streams say.
-  ChildProcess logger("lcm-logger",
-                      {"lcm-logger", "--lcm-url=" + url, "-f", recording_path.string()},
-                      nodeLog("lcm-logger"));
+  const LaunchHost& logger_host = hosts.hostOf(kLoggerNode);
+  ChildProcess logger(
+      "lcm-logger",
+      hosts.command(logger_host, {"lcm-logger", "--lcm-url=" + url, "-f", recording_path.string()},
+                    bin_dir),
+      nodeLog("lcm-logger"));
   RecordingCounter recording(recording_path.string());
   std::vector<LaunchedNode> launched;
   std::map<std::string, ChannelHealth> channels;
@@ -196,8 +307,12 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       argv.push_back("--set");
       argv.push_back(assignment);
     }
-    launched.push_back({entry.get(), std::make_unique<ChildProcess>(entry->info().program, argv,
-                                                                    nodeLog(entry->info().name))});
+    const LaunchHost& host = hosts.hostOf(entry->info().name);
+    launched.push_back(
+        {entry.get(),
+         std::make_unique<ChildProcess>(entry->info().program, hosts.command(host, argv, bin_dir),
+                                        nodeLog(entry->info().name)),
+         host.name});
   }
   for (const auto& [channel, rate_hz] : nodes::expectedRates(scenario)) {
     channels[channel].expected_hz = rate_hz;
@@ -216,11 +331,28 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // Health: what arrives on the bus, against what the scenario should produce;
   // the nodes' heartbeats say they are up and what they have done.
   auto bus = core::openBus(scenario.bus);
+  const auto bus_opened = Clock::now();
   std::map<std::string, NodeReport> heartbeats;  // by node name
+  ForeignSimulator foreign;
+  bool simulator_started = false;
+  const std::string simulator_name = [&] {
+    for (const LaunchedNode& node : launched) {
+      if (isSimulator(node)) return node.entry->info().name;
+    }
+    return std::string();
+  }();
   auto subscription = bus->subscribe(".*", [&](const core::RawMessage& raw) {
+    if (raw.channel == kBusCheckChannel) return;
+    if (!simulator_started && !foreign.seen && raw.channel == scenario.sim.truth.channel) {
+      foreign.seen = "its truth arrives on " + scenario.sim.truth.channel;
+    }
     if (raw.channel == scenario.bus.heartbeat_channel) {
       try {
         const msg::Heartbeat beat = msg::decode<msg::Heartbeat>(raw.data, raw.size);
+        if (!simulator_started && beat.node == simulator_name && !foreign.seen) {
+          foreign.seen = "a heartbeat of " + simulator_name + " pid " + std::to_string(beat.pid);
+          return;
+        }
         NodeReport& report = heartbeats[beat.node];
         report.working = beat.sent != report.sent;
         report.sent = beat.sent;
@@ -248,7 +380,33 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
 
   out << "launch: " << options.scenario << " on " << url << "; node logs and the recording in "
       << out_dir << "\n";
+  std::map<std::string, std::vector<std::string>> nodes_by_host;
+  for (const LaunchedNode& node : launched) {
+    nodes_by_host[node.host].push_back(node.entry->info().name);
+  }
+  if (several_hosts) {
+    for (const std::string& host : used_hosts) {
+      out << "launch: host " << hosts.host(host).describe() << ":";
+      if (host == logger_host.name) out << " lcm-logger";
+      for (const std::string& node : nodes_by_host[host]) out << " " << node;
+      out << "\n";
+    }
+    const std::string problem = checkBusReachesHosts(
+        *bus, hosts, used_hosts, url, bin_dir, out_path, options.bus_check_timeout_s, stop, out);
+    if (!problem.empty()) {
+      out << "launch: " << problem << "\n";
+      return stop ? 130 : 1;
+    }
+  }
+  // A second simulator is refused before anything starts (and checked again
+  // before this one does, once its heartbeat has had time to come).
+  while (Clock::now() - bus_opened < std::chrono::milliseconds(200)) {
+    bus->handle(std::chrono::milliseconds(20));
+  }
+  foreign.refuseIfSeen(url);
   int result = 0;
+  // Over ssh the logger writes on another machine; seen here only through a shared folder.
+  const auto recordingHere = [&] { return !logger_host.viaSsh() || fs::exists(recording_path); };
   const auto stopAll = [&] {
     for (auto it = processes.rbegin(); it != processes.rend(); ++it) (*it)->stop(5.0);
   };
@@ -283,6 +441,15 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         bus->handle(std::chrono::milliseconds(100));
       }
     }
+    // Heartbeats come once a second: listen that long before the check.
+    while (Clock::now() - bus_opened < std::chrono::milliseconds(1500) && !foreign.seen) {
+      bus->handle(std::chrono::milliseconds(50));
+    }
+    if (foreign.seen) {
+      stopAll();
+      foreign.refuseIfSeen(url);
+    }
+    simulator_started = true;
     simulator->start();
     out << "launch: nadir-sim started; Ctrl-C stops every node\n";
 
@@ -313,7 +480,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
             if (report == heartbeats.end()) return false;
             if (isSimulator(node) ? !report->second.done : report->second.working) return false;
           }
-          return missingFromRecording(heartbeats, recording).empty();
+          return !recordingHere() || missingFromRecording(heartbeats, recording).empty();
         };
         while (!stop && !settled() && Clock::now() < settle_deadline) {
           bus->handle(std::chrono::milliseconds(100));
@@ -337,7 +504,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       if (window_s >= options.report_period_s) {
         last_report = now;
         printHealth(out, std::chrono::duration<double>(now - started).count(), window_s,
-                    scenario.time.speed, channels, heartbeats);
+                    scenario.time.speed, channels, heartbeats, nodes_by_host);
         recording.update();
       }
     }
@@ -346,12 +513,14 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     throw;
   }
   out << "launch: nodes\n";
+  std::map<const ChildProcess*, std::string> host_of = {{&logger, logger_host.name}};
+  for (const LaunchedNode& node : launched) host_of[node.process.get()] = node.host;
   for (const ChildProcess* node : processes) {
     const bool clean =
         node->exitStatus() == 0 || (node->stoppedByUs() && node->exitStatus() != 128 + SIGKILL);
-    out << "  " << node->name() << ": " << node->describeExit()
-        << (node->stoppedByUs() ? " (stopped by launch)" : "") << (clean ? "" : "  <- problem")
-        << "\n";
+    out << "  " << node->name() << (several_hosts ? " on " + host_of[node] : "") << ": "
+        << node->describeExit() << (node->stoppedByUs() ? " (stopped by launch)" : "")
+        << (clean ? "" : "  <- problem") << "\n";
     if (!clean && result == 0) result = 1;
   }
   out << "launch: messages received\n";
@@ -359,6 +528,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     out << "  " << name << ": " << health.total;
     if (health.expected_hz > 0.0) out << " (" << health.missing() << " missing)";
     out << "\n";
+  }
+  if (!recordingHere()) {
+    out << "launch: the recording is on " << logger_host.describe() << " at "
+        << recording_path.string() << " (not seen from here: not checked, no charts)\n";
+    return result;
   }
   recording.update();
   const auto missing = missingFromRecording(heartbeats, recording);

@@ -23,6 +23,10 @@ struct LaunchOptions {
   std::string bin_dir;
   // Seconds between health reports.
   double report_period_s = 2.0;
+  // Where each node runs (run/launch_hosts.h); empty: all on this machine.
+  std::string hosts_file;
+  // How long the bus may take to join every host before the flight is refused.
+  double bus_check_timeout_s = 20.0;
 };
 
 // Runs until the scenario ends, a node dies or stop becomes true. Returns the

@@ -14,18 +14,12 @@
 
 #include "core/params.h"
 #include "run/process.h"
+#include "run/yaml_file.h"
 
 namespace nadir::run {
 namespace {
 
 namespace fs = std::filesystem;
-
-[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key,
-                       const std::string& problem) {
-  const std::string where =
-      node.Mark().is_null() ? path : path + ":" + std::to_string(node.Mark().line + 1);
-  throw core::ParamError(where + ": " + key + ": " + problem);
-}
 
 std::string lastPart(const std::string& key) {
   const auto dot = key.rfind('.');
@@ -67,15 +61,7 @@ std::vector<std::string> SweepAxis::overrides(std::size_t i) const {
 }
 
 SweepSpec loadSweep(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw core::ParamError(path + ": cannot open sweep file");
-  } catch (const YAML::ParserException& e) {
-    throw core::ParamError(path + ":" + std::to_string(e.mark.line + 1) +
-                           ": not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = loadYamlFile(path, "sweep file");
   if (!root.IsMap())
     throw core::ParamError(path + ": expected a map (scenario, out, jobs, set, axes)");
   SweepSpec spec;
@@ -89,13 +75,13 @@ SweepSpec loadSweep(const std::string& path) {
         spec.out_dir = value.as<std::string>();
       } else if (key == "jobs") {
         spec.jobs = value.as<int>();
-        if (spec.jobs < 1) fail(path, value, key, "must be at least 1");
+        if (spec.jobs < 1) failAt(path, value, key, "must be at least 1");
       } else if (key == "images") {
         spec.images = value.as<bool>();
       } else if (key == "set") {
         spec.shared_overrides = value.as<std::vector<std::string>>();
       } else if (key == "axes") {
-        if (!value.IsMap()) fail(path, value, key, "expected a map of key: [values]");
+        if (!value.IsMap()) failAt(path, value, key, "expected a map of key: [values]");
         for (const auto& axis : value) {
           SweepAxis parsed{axis.first.as<std::string>(), {}, {}};
           const std::string where = "axes." + parsed.key;
@@ -103,11 +89,12 @@ SweepSpec loadSweep(const std::string& path) {
             for (const auto& variant : axis.second) {
               const std::string name = variant.first.as<std::string>();
               if (!variant.second.IsSequence())
-                fail(path, variant.second, where + "." + name, "expected a list of key=value");
+                failAt(path, variant.second, where + "." + name, "expected a list of key=value");
               std::vector<std::string> overrides;
               for (const auto& v : variant.second) {
                 if (!v.IsScalar() || v.Scalar().find('=') == std::string::npos)
-                  fail(path, v, where + "." + name, "expected key=value, got '" + v.Scalar() + "'");
+                  failAt(path, v, where + "." + name,
+                         "expected key=value, got '" + v.Scalar() + "'");
                 overrides.push_back(v.Scalar());
               }
               parsed.values.push_back(name);
@@ -115,20 +102,21 @@ SweepSpec loadSweep(const std::string& path) {
             }
           } else if (axis.second.IsSequence() && axis.second.size() > 0) {
             for (const auto& v : axis.second) {
-              if (!v.IsScalar()) fail(path, v, where, "values must be scalars");
+              if (!v.IsScalar()) failAt(path, v, where, "values must be scalars");
               parsed.values.push_back(v.Scalar());
             }
           } else {
-            fail(path, axis.second, where,
-                 "expected a non-empty list of values or a map of named variants");
+            failAt(path, axis.second, where,
+                   "expected a non-empty list of values or a map of named variants");
           }
           spec.axes.push_back(std::move(parsed));
         }
       } else {
-        fail(path, entry.first, key, "unknown key (known: scenario, out, jobs, set, images, axes)");
+        failAt(path, entry.first, key,
+               "unknown key (known: scenario, out, jobs, set, images, axes)");
       }
     } catch (const YAML::BadConversion&) {
-      fail(path, value, key, "has the wrong type");
+      failAt(path, value, key, "has the wrong type");
     }
   }
   if (spec.scenario.empty()) throw core::ParamError(path + ": scenario: missing");

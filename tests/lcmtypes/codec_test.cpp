@@ -453,6 +453,19 @@ TEST(Codec, WrongTypeIsADecodeError) {
   EXPECT_EQ(typeName(three, 3), "");
 }
 
+// A bus check comes back whole, its hosts as a set.
+TEST(Codec, BusCheckRoundTrip) {
+  const BusCheck check{1'700'000'000'000'000, 77, "air", 4242, {"ground", "launch"}};
+  const Bytes bytes = encode(check);
+  EXPECT_EQ(typeName(bytes.data(), bytes.size()), "bus_check_t");
+  const BusCheck back = decode<BusCheck>(bytes);
+  EXPECT_EQ(back.utime, check.utime);
+  EXPECT_EQ(back.launch_id, 77);
+  EXPECT_EQ(back.host, "air");
+  EXPECT_EQ(back.pid, 4242);
+  EXPECT_EQ(back.heard, (std::set<std::string>{"ground", "launch"}));
+}
+
 // A heartbeat and a VO command come back whole.
 TEST(Codec, HeartbeatAndCommandRoundTrip) {
   const Heartbeat beat{1'700'000'000'000'000,

@@ -9,19 +9,14 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <memory>
 #include <string>
-#include <thread>
-#include <vector>
 
-#include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
-#include "run/process.h"
 #include "tests/support/hosts.h"
+#include "tests/support/playback.h"
 #include "tests/support/run_command.h"
 
 namespace nadir::test {
@@ -30,47 +25,12 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kBin[] = NADIR_BIN_DIR;
-constexpr char kUrl[] = "udpm://239.255.76.67:7671?ttl=1";
-// What the VO nodes read and the recorder keeps: the flight, not its estimates.
-constexpr char kPlayedChannels[] =
-    "POSE_TRUTH|NAV_.*|RANGE|CAMERA_DOWN|CAMERA_DOWN_INFO|IMU|BARO|GPS|MAG";
 constexpr double kFlightS = 8.0;
 
-std::string bin(const std::string& program) { return (fs::path(kBin) / program).string(); }
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Waits until the program's log holds text (it has set up), or it died.
-::testing::AssertionResult waitForLine(run::ChildProcess& process, const std::string& text) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (readText(process.logPath()).find(text) != std::string::npos) {
-      return ::testing::AssertionSuccess();
-    }
-    if (!process.running()) {
-      return ::testing::AssertionFailure() << process.name() << " ended (" << process.describeExit()
-                                           << "): " << readText(process.logPath());
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return ::testing::AssertionFailure() << process.name() << " never printed '" << text << "'";
-}
-
-std::int64_t eventsOn(const fs::path& log, const std::string& channel) {
-  core::LcmLogReader reader(log.string());
-  std::int64_t count = 0;
-  while (const auto event = reader.next()) count += event->channel == channel ? 1 : 0;
-  return count;
-}
-
-// The flight flown in one process: its log, and the VO metrics it gave.
+// The flight flown in one process: its folder (log, scenario, VO metrics).
 fs::path flyInOneProcess(const fs::path& dir, const std::string& extra_set) {
-  const std::string command = bin("nadir") + " run default --out " + dir.string() +
+  const std::string command = (fs::path(kBin) / "nadir").string() + " run default --out " +
+                              dir.string() +
                               " --force --set duration_s=" + std::to_string(kFlightS) +
                               " --set nav.enabled=false" + extra_set;
   const auto [status, output] = runCommand(command);
@@ -78,62 +38,20 @@ fs::path flyInOneProcess(const fs::path& dir, const std::string& extra_set) {
   return dir;
 }
 
-struct Playback {
-  std::string player_output;
-  std::string recorder_output;
-  std::vector<std::string> vo_outputs;
-  fs::path recording;
-};
-
-// A plays the flight, B runs the VO nodes, C records.
-Playback playAcross(const TestHosts& hosts, const fs::path& flight, const std::string& encoding,
-                    const fs::path& out) {
-  fs::create_directories(out);
-  Playback result;
-  result.recording = out / "recorded.lcmlog";
-  const auto onHost = [&](int host, std::vector<std::string> argv) {
-    std::vector<std::string> command = {"ip", "netns", "exec", hosts.name(host)};
-    command.insert(command.end(), argv.begin(), argv.end());
-    return command;
-  };
-  run::ChildProcess recorder(
-      "recorder",
-      onHost(2, {bin("nadir"), "log", "record", result.recording.string(), "--url", kUrl,
-                 "--scenario", "default", "--idle-stop", "5", "--force"}),
-      (out / "recorder.out").string());
-  std::vector<std::unique_ptr<run::ChildProcess>> vo_nodes;
-  for (const char* program : {"nadir-vo-feature", "nadir-vo-direct"}) {
-    vo_nodes.push_back(std::make_unique<run::ChildProcess>(
-        program,
-        onHost(1, {bin(program), "default", "--set", std::string("bus.url=") + kUrl, "--set",
-                   "vo_feature.vo.background_ba=false"}),
-        (out / (std::string(program) + ".out")).string()));
-  }
-  recorder.start();
-  EXPECT_TRUE(waitForLine(recorder, "Ctrl-C stops"));
-  for (auto& node : vo_nodes) {
-    node->start();
-    EXPECT_TRUE(waitForLine(*node, "bus: "));
-  }
-  const auto [status, output] = runCommand(
-      hosts.prefix(0) + bin("nadir") + " log play " + (flight / "run.lcmlog").string() +
-      " --url '" + kUrl + "' --channels '" + kPlayedChannels + "' --image-encoding " + encoding);
-  EXPECT_EQ(status, 0) << output;
-  result.player_output = output;
-  // The recorder stops once the VO nodes have sent their last pose.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
-  while (recorder.running() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  EXPECT_FALSE(recorder.running()) << "the recorder did not stop";
-  recorder.stop(5.0);
-  EXPECT_EQ(recorder.exitStatus(), 0) << readText(recorder.logPath());
-  result.recorder_output = readText(recorder.logPath());
-  for (auto& node : vo_nodes) {
-    node->stop(10.0);
-    EXPECT_EQ(node->exitStatus(), 0) << readText(node->logPath());
-    result.vo_outputs.push_back(readText(node->logPath()));
-  }
+// A plays the flight, B runs both VO nodes (the feature VO's bundle
+// adjustment on its tracking thread, as in the one-process run), C records.
+PlaybackResult playAcross(const TestHosts& hosts, const fs::path& flight,
+                          const std::string& encoding, const fs::path& out) {
+  PlaybackSetup setup;
+  setup.bin_dir = kBin;
+  setup.flight = flight;
+  setup.url = "udpm://239.255.76.67:7671?ttl=1";
+  setup.image_encoding = encoding;
+  setup.vo_programs = {"nadir-vo-feature", "nadir-vo-direct"};
+  setup.vo_sets = {"vo_feature.vo.background_ba=false"};
+  setup.out = out;
+  PlaybackResult result = playAcrossHosts(hosts, setup);
+  EXPECT_TRUE(result.ok) << result.problem;
   return result;
 }
 
@@ -155,22 +73,9 @@ void expectSameMetrics(const fs::path& recording, const fs::path& reference_run)
   }
 }
 
-// What the line "  CHANNEL: N messages, B bytes..." of a program's output says.
-std::int64_t bytesOn(const std::string& output, const std::string& channel) {
-  const std::string key = "  " + channel + ": ";
-  const std::size_t at = output.find(key);
-  if (at == std::string::npos) return -1;
-  std::istringstream line(output.substr(at + key.size()));
-  std::int64_t bytes = -1;
-  line >> bytes;
-  return bytes;
-}
-
 class PlaybackAcrossHosts : public ::testing::Test {
  protected:
   void SetUp() override {
-    long rmem_max = 0;
-    std::ifstream("/proc/sys/net/core/rmem_max") >> rmem_max;
     long rmem_default = 0;
     std::ifstream("/proc/sys/net/core/rmem_default") >> rmem_default;
     if (rmem_default < 64L << 20) {
@@ -194,7 +99,7 @@ class PlaybackAcrossHosts : public ::testing::Test {
 // lost nothing, and the poses give the one-process run's metrics.
 TEST_F(PlaybackAcrossHosts, RawFramesGiveTheOneProcessMetrics) {
   const fs::path flight = flyInOneProcess(dir_ / "raw_flight", "");
-  const Playback played = playAcross(*hosts_, flight, "raw", dir_ / "raw_played");
+  const PlaybackResult played = playAcross(*hosts_, flight, "raw", dir_ / "raw_played");
   EXPECT_NE(played.recorder_output.find("nothing lost on"), std::string::npos)
       << played.recorder_output;
   for (const std::string& vo : played.vo_outputs) {
@@ -217,12 +122,12 @@ TEST_F(PlaybackAcrossHosts, JpegFramesGiveTheOneProcessJpegMetrics) {
   const fs::path flight = flyInOneProcess(dir_ / "raw_flight", "");
   const fs::path jpeg_flight =
       flyInOneProcess(dir_ / "jpeg_flight", " --set camera.jpeg_quality=90");
-  const Playback played = playAcross(*hosts_, flight, "jpeg:90", dir_ / "jpeg_played");
+  const PlaybackResult played = playAcross(*hosts_, flight, "jpeg:90", dir_ / "jpeg_played");
   EXPECT_NE(played.recorder_output.find("nothing lost on"), std::string::npos)
       << played.recorder_output;
   EXPECT_EQ(eventsOn(played.recording, "CAMERA_DOWN"),
             eventsOn(flight / "run.lcmlog", "CAMERA_DOWN"));
-  const std::int64_t jpeg_bytes = bytesOn(played.player_output, "CAMERA_DOWN");
+  const std::int64_t jpeg_bytes = reportedNumber(played.player_output, "CAMERA_DOWN");
   const std::int64_t raw_frame_bytes = 640 * 480;
   EXPECT_GT(jpeg_bytes, 0) << played.player_output;
   EXPECT_LT(jpeg_bytes, eventsOn(flight / "run.lcmlog", "CAMERA_DOWN") * raw_frame_bytes / 3)

@@ -442,7 +442,9 @@ TEST(Launch, FliesAndStopsCleanly) {
   LaunchOptions options;
   options.scenario = "default";
   options.out_dir = dir;
-  options.overrides = {"duration_s=2", "camera.width=160", "camera.height=120"};
+  // A bus of its own: a second simulator on one bus is refused.
+  options.overrides = {"duration_s=2", "camera.width=160", "camera.height=120",
+                       "bus.url=udpm://239.255.76.67:7873?ttl=0"};
   options.bin_dir = NADIR_BIN_DIR;
   options.report_period_s = 1.0;
   std::atomic<bool> stop{false};
@@ -497,7 +499,7 @@ TEST(Launch, ADeadNodeIsReported) {
   options.scenario = "default";
   options.out_dir = (fs::path(dir) / "out").string();
   options.overrides = {"duration_s=30", "vo_feature.enabled=false", "vo_direct.enabled=false",
-                       "nav.enabled=false"};
+                       "nav.enabled=false", "bus.url=udpm://239.255.76.67:7874?ttl=0"};
   options.bin_dir = bin.string();
   std::atomic<bool> stop{false};
   std::ostringstream out;
