@@ -9,7 +9,8 @@
 // It prints the node's effective parameters, opens the bus, builds the node
 // from its registry entry, publishes a heartbeat_t when the node is ready and
 // then once a second (nadir launch waits for the first), runs the node until it
-// is done or SIGINT/SIGTERM, and prints what the node did.
+// is done or SIGINT/SIGTERM/SIGHUP, and prints what the node did and, per
+// channel, what reached it and what was lost on the way (core/stream_gaps.h).
 
 namespace nadir::nodes {
 

@@ -12,6 +12,15 @@ namespace nadir::run {
 // The folder of the running program (where its sibling programs are); "." if unknown.
 std::string selfDirectory();
 
+// Runs a program to its end (found on PATH if argv[0] has no slash) and
+// returns its exit status (as a shell reports it) and what it wrote on stdout
+// and stderr. Throws std::runtime_error when it cannot start.
+struct CommandOutput {
+  int status = -1;
+  std::string output;
+};
+CommandOutput runAndCapture(const std::vector<std::string>& argv);
+
 class ChildProcess {
  public:
   ChildProcess(std::string name, std::vector<std::string> argv, std::string log_path);

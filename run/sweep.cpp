@@ -7,9 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "core/params.h"
@@ -78,6 +81,35 @@ SweepSpec loadSweep(const std::string& path) {
         if (spec.jobs < 1) failAt(path, value, key, "must be at least 1");
       } else if (key == "images") {
         spec.images = value.as<bool>();
+      } else if (key == "slurm") {
+        if (!value.IsMap())
+          failAt(path, value, key, "expected a map (cpus_per_task, mem, time, ...)");
+        for (const auto& field : value) {
+          const std::string name = field.first.as<std::string>();
+          const std::string where = "slurm." + name;
+          try {
+            if (name == "cpus_per_task") {
+              spec.slurm.cpus_per_task = field.second.as<int>();
+              if (spec.slurm.cpus_per_task < 1)
+                failAt(path, field.second, where, "must be at least 1");
+            } else if (name == "mem") {
+              spec.slurm.mem = field.second.as<std::string>();
+            } else if (name == "time") {
+              spec.slurm.time = field.second.as<std::string>();
+            } else if (name == "partition") {
+              spec.slurm.partition = field.second.as<std::string>();
+            } else if (name == "account") {
+              spec.slurm.account = field.second.as<std::string>();
+            } else if (name == "extra") {
+              spec.slurm.extra = field.second.as<std::vector<std::string>>();
+            } else {
+              failAt(path, field.first, where,
+                     "unknown key (known: cpus_per_task, mem, time, partition, account, extra)");
+            }
+          } catch (const YAML::BadConversion&) {
+            failAt(path, field.second, where, "has the wrong type");
+          }
+        }
       } else if (key == "set") {
         spec.shared_overrides = value.as<std::vector<std::string>>();
       } else if (key == "axes") {
@@ -113,7 +145,7 @@ SweepSpec loadSweep(const std::string& path) {
         }
       } else {
         failAt(path, entry.first, key,
-               "unknown key (known: scenario, out, jobs, set, images, axes)");
+               "unknown key (known: scenario, out, jobs, set, images, axes, slurm)");
       }
     } catch (const YAML::BadConversion&) {
       failAt(path, value, key, "has the wrong type");
@@ -152,40 +184,126 @@ std::vector<SweepCell> planSweep(const SweepSpec& spec) {
   return cells;
 }
 
+std::string describeProgress(const SweepProgress& p) {
+  char text[256];
+  std::snprintf(text, sizeof(text), "%zu/%zu done", p.done, p.total);
+  std::string line = text;
+  if (p.done_before > 0) line += " (" + std::to_string(p.done_before) + " before)";
+  std::snprintf(text, sizeof(text), ", %zu failed, %zu running, %zu waiting", p.failed, p.running,
+                p.pending);
+  line += text;
+  if (p.remaining_s > 0.0) {
+    std::snprintf(text, sizeof(text),
+                  p.remaining_s >= 120.0 ? ", about %.0f min to go" : ", about %.0f s to go",
+                  p.remaining_s >= 120.0 ? p.remaining_s / 60.0 : p.remaining_s);
+    line += text;
+  }
+  return line;
+}
+
+std::vector<std::string> cellCommand(const SweepSpec& spec, const SweepCell& cell,
+                                     const std::string& nadir_program) {
+  std::vector<std::string> argv = {nadir_program, "run",        spec.scenario,
+                                   "--out",       cell.out_dir, "--force"};
+  if (!spec.images) argv.push_back("--no-images");
+  for (const std::string& assignment : spec.shared_overrides) {
+    argv.push_back("--set");
+    argv.push_back(assignment);
+  }
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const SweepAxis& axis = spec.axes[a];
+    const auto value = std::find(axis.values.begin(), axis.values.end(), cell.values[a]);
+    for (const std::string& assignment :
+         axis.overrides(static_cast<std::size_t>(value - axis.values.begin()))) {
+      argv.push_back("--set");
+      argv.push_back(assignment);
+    }
+  }
+  return argv;
+}
+
+namespace {
+
+// The command that made a cell, one word a line, without the program (the
+// same run made by another build or another machine's path is the same run).
+std::string commandRecord(const std::vector<std::string>& command) {
+  std::string text;
+  for (std::size_t i = 1; i < command.size(); ++i) text += command[i] + "\n";
+  return text;
+}
+
+fs::path commandFile(const SweepCell& cell) { return fs::path(cell.out_dir) / "sweep_cell.txt"; }
+
+// Before a cell runs: what will make it, and no metrics from an earlier run.
+void prepareCell(const SweepCell& cell, const std::vector<std::string>& command) {
+  fs::create_directories(cell.out_dir);
+  fs::remove(fs::path(cell.out_dir) / "metrics.json");
+  std::ofstream(commandFile(cell)) << commandRecord(command);
+}
+
+}  // namespace
+
+bool cellDone(const SweepCell& cell, const std::vector<std::string>& command) {
+  std::ifstream in(commandFile(cell));
+  if (!in) return false;
+  std::stringstream recorded;
+  recorded << in.rdbuf();
+  if (recorded.str() != commandRecord(command)) return false;
+  SweepCell read = cell;
+  readCellMetrics(read);
+  return read.metrics.has_value();
+}
+
+int runCell(const SweepSpec& spec, std::size_t index, const std::string& nadir_program) {
+  const std::vector<SweepCell> cells = planSweep(spec);
+  if (index >= cells.size()) {
+    throw std::invalid_argument("no cell " + std::to_string(index) + ": the sweep has " +
+                                std::to_string(cells.size()) + " (0-" +
+                                std::to_string(cells.size() - 1) + ")");
+  }
+  const SweepCell& cell = cells[index];
+  const std::vector<std::string> command = cellCommand(spec, cell, nadir_program);
+  prepareCell(cell, command);
+  ChildProcess child("cell " + std::to_string(index), command,
+                     (fs::path(cell.out_dir) / "run.out").string());
+  child.start();
+  while (child.running()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  return child.exitStatus();
+}
+
 std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_program,
-                                const std::function<void(const SweepProgress&)>& on_progress) {
+                                const std::function<void(const SweepProgress&)>& on_progress,
+                                bool rerun) {
   std::vector<SweepCell> cells = planSweep(spec);
   const std::size_t jobs = spec.jobs > 0 ? static_cast<std::size_t>(spec.jobs)
                                          : std::max(1u, std::thread::hardware_concurrency());
   SweepProgress progress;
   progress.total = cells.size();
+  std::vector<std::size_t> to_run;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (!rerun && cellDone(cells[i], cellCommand(spec, cells[i], nadir_program))) {
+      readCellMetrics(cells[i]);
+      cells[i].exit_status = 0;
+      ++progress.done_before;
+    } else {
+      to_run.push_back(i);
+    }
+  }
+  progress.done = progress.done_before;
   const auto started = std::chrono::steady_clock::now();
   std::map<std::size_t, std::unique_ptr<ChildProcess>> running;
-  std::size_t next = 0;
-  while (next < cells.size() || !running.empty()) {
-    while (next < cells.size() && running.size() < jobs) {
-      SweepCell& cell = cells[next];
-      fs::create_directories(cell.out_dir);
-      std::vector<std::string> argv = {nadir_program, "run",        spec.scenario,
-                                       "--out",       cell.out_dir, "--force"};
-      if (!spec.images) argv.push_back("--no-images");
-      for (const std::string& assignment : spec.shared_overrides) {
-        argv.push_back("--set");
-        argv.push_back(assignment);
-      }
-      for (std::size_t a = 0; a < spec.axes.size(); ++a) {
-        const SweepAxis& axis = spec.axes[a];
-        const auto value = std::find(axis.values.begin(), axis.values.end(), cell.values[a]);
-        for (const std::string& assignment :
-             axis.overrides(static_cast<std::size_t>(value - axis.values.begin()))) {
-          argv.push_back("--set");
-          argv.push_back(assignment);
-        }
-      }
-      auto child = std::make_unique<ChildProcess>("run " + std::to_string(next), argv,
-                                                  (fs::path(cell.out_dir) / "run.out").string());
+  std::size_t next = 0;  // into to_run
+  std::size_t finished_here = 0;
+  while (next < to_run.size() || !running.empty()) {
+    while (next < to_run.size() && running.size() < jobs) {
+      const std::size_t index = to_run[next++];
+      const std::vector<std::string> command = cellCommand(spec, cells[index], nadir_program);
+      prepareCell(cells[index], command);
+      auto child =
+          std::make_unique<ChildProcess>("run " + std::to_string(index), command,
+                                         (fs::path(cells[index].out_dir) / "run.out").string());
       child->start();
-      running.emplace(next++, std::move(child));
+      running.emplace(index, std::move(child));
     }
     for (auto it = running.begin(); it != running.end();) {
       if (it->second->running()) {
@@ -200,12 +318,19 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
         cell.error = it->second->describeExit() + " (see " + it->second->logPath() + ")";
       }
       ++progress.done;
+      ++finished_here;
       if (!cell.metrics) ++progress.failed;
       it = running.erase(it);
     }
     progress.running = running.size();
+    progress.pending = to_run.size() - next;
     progress.elapsed_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    // At the pace so far: cells finished per second here, over what is left.
+    progress.remaining_s = finished_here > 0
+                               ? progress.elapsed_s / static_cast<double>(finished_here) *
+                                     static_cast<double>(progress.running + progress.pending)
+                               : 0.0;
     if (on_progress) on_progress(progress);
     if (!running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }

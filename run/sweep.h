@@ -17,6 +17,17 @@
 //     effect:                      # named variants: each value a list of overrides
 //       ideal: []
 //       noise: [camera.read_noise_counts=2, camera.shot_noise_electrons_per_count=10]
+//   slurm:                         # what each cell asks of a Slurm cluster (run/slurm.h)
+//     cpus_per_task: 2
+//     mem: 8G
+//     time: "01:00:00"
+//     partition: batch             # optional, as are account and extra
+//     account: vision
+//     extra: [--qos=normal]
+//
+// A cell is done when its metrics.json reads and the command that made it
+// (OUT/cell_.../sweep_cell.txt) is the one the sweep would run now: a sweep
+// run again (after a failure, or with more axis values) runs only the rest.
 
 #include <functional>
 #include <optional>
@@ -39,6 +50,17 @@ struct SweepAxis {
   std::vector<std::string> overrides(std::size_t i) const;
 };
 
+// What each cell asks of a Slurm cluster: sbatch's --cpus-per-task, --mem,
+// --time, --partition and --account, and any other sbatch options.
+struct SlurmResources {
+  int cpus_per_task = 2;
+  std::string mem = "4G";
+  std::string time = "02:00:00";
+  std::string partition;
+  std::string account;
+  std::vector<std::string> extra;
+};
+
 struct SweepSpec {
   std::string scenario;
   std::string out_dir = "out/sweep";
@@ -48,6 +70,7 @@ struct SweepSpec {
   // Record the camera images in each cell's run.lcmlog (off: the logs hold
   // everything else and the metrics are the same, at a fraction of the size).
   bool images = false;
+  SlurmResources slurm;
 };
 
 // Throws core::ParamError naming the file, line and problem.
@@ -66,15 +89,35 @@ struct SweepCell {
 // Every combination of the axes' values, the last axis varying fastest.
 std::vector<SweepCell> planSweep(const SweepSpec& spec);
 
+// Where a sweep stands: cells done (before this run too: done_before of
+// them), failed, running and waiting, and the time left at the pace of the
+// cells that ran (0 while none has).
 struct SweepProgress {
-  std::size_t done = 0, failed = 0, running = 0, total = 0;
+  std::size_t done = 0, done_before = 0, failed = 0, running = 0, pending = 0, total = 0;
   double elapsed_s = 0.0;
+  double remaining_s = 0.0;
 };
 
-// Runs `nadir_program run` for every cell, spec.jobs at a time, and reads each
-// cell's metrics.json. A failed cell is kept with its error; the others go on.
+// "12/48 done (3 before), 1 failed, 2 running, 33 waiting, about 20 min to go".
+std::string describeProgress(const SweepProgress& progress);
+
+// The `nadir run` command of a cell (argv[0] = nadir_program).
+std::vector<std::string> cellCommand(const SweepSpec& spec, const SweepCell& cell,
+                                     const std::string& nadir_program);
+// True when the cell's metrics.json reads and sweep_cell.txt holds command.
+bool cellDone(const SweepCell& cell, const std::vector<std::string>& command);
+
+// Runs one cell now, in this process's child (what a Slurm array task does):
+// sweep_cell.txt written, an earlier metrics.json removed, output in
+// OUT/run.out. Returns the run's exit status.
+int runCell(const SweepSpec& spec, std::size_t index, const std::string& nadir_program);
+
+// Runs `nadir_program run` for every cell not done (every cell with rerun),
+// spec.jobs at a time, and reads each cell's metrics.json. A failed cell is
+// kept with its error; the others go on.
 std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_program,
-                                const std::function<void(const SweepProgress&)>& on_progress);
+                                const std::function<void(const SweepProgress&)>& on_progress,
+                                bool rerun = false);
 
 // A finished cell's OUT/metrics.json into cell.metrics, or why not into cell.error.
 void readCellMetrics(SweepCell& cell);

@@ -84,15 +84,6 @@ class TestHosts {
     for (const std::string& ns : names_) runCommand("ip netns del " + ns);
     names_.clear();
   }
-  // A process that has not exited (a zombie has: its parent has not yet
-  // collected it).
-  static bool alive(long pid) {
-    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-    std::string line;
-    if (!std::getline(stat, line)) return false;
-    const std::size_t close = line.rfind(')');
-    return close == std::string::npos || close + 2 >= line.size() || line[close + 2] != 'Z';
-  }
   // Namespaces of fixtures whose process is gone.
   static void removeStale() {
     const auto [status, output] = runCommand("ip netns list");
@@ -102,7 +93,7 @@ class TestHosts {
     while (lines >> ns) {
       if (ns.rfind("nadirh", 0) != 0) continue;
       const long pid = std::strtol(ns.c_str() + 6, nullptr, 10);
-      if (pid > 0 && !alive(pid)) runCommand("ip netns del " + ns);
+      if (pid > 0 && !processAlive(pid)) runCommand("ip netns del " + ns);
       std::string rest;
       std::getline(lines, rest);  // "(id: N)" after the name
     }
