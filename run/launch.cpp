@@ -49,18 +49,15 @@ struct ChannelHealth {
   std::int64_t window = 0;
   // Rate the scenario should produce, Hz of sim time; 0 when not known.
   double expected_hz = 0.0;
-  std::optional<std::int64_t> first_utime, last_utime;
   int vo_status = -1;
-
-  // Messages missing so far: what the sim-time span at expected_hz holds
-  // minus what arrived (the messages carry their sim time).
-  std::int64_t missing() const {
-    if (expected_hz <= 0.0 || !first_utime) return 0;
-    const double span_s = core::secondsFromUtime(*last_utime - *first_utime);
-    const auto expected = static_cast<std::int64_t>(std::floor(span_s * expected_hz + 1e-6)) + 1;
-    return std::max<std::int64_t>(0, expected - total);
-  }
 };
+
+// Messages lost on the way to this process, from their times (the bus's count).
+std::int64_t missingOn(const std::map<std::string, core::ChannelStats>& stats,
+                       const std::string& channel) {
+  const auto it = stats.find(channel);
+  return it == stats.end() ? 0 : it->second.missing;
+}
 
 // The recording's messages by channel, read as lcm-logger writes it: each
 // update() reads only what was appended since the last.
@@ -206,6 +203,7 @@ std::string checkBusReachesHosts(core::Bus& bus, const LaunchHosts& hosts,
 // produce, the VO nodes' status, and what each node's heartbeat says.
 void printHealth(std::ostream& out, double elapsed_s, double window_s, double speed,
                  std::map<std::string, ChannelHealth>& channels,
+                 const std::map<std::string, core::ChannelStats>& stats,
                  const std::map<std::string, NodeReport>& heartbeats,
                  const std::map<std::string, std::vector<std::string>>& nodes_by_host) {
   char line[256];
@@ -217,7 +215,7 @@ void printHealth(std::ostream& out, double elapsed_s, double window_s, double sp
     out << line;
     if (health.expected_hz > 0.0) {
       std::snprintf(line, sizeof(line), " (expected %.1f), %lld missing",
-                    health.expected_hz * speed, static_cast<long long>(health.missing()));
+                    health.expected_hz * speed, static_cast<long long>(missingOn(stats, name)));
       out << line;
     }
     if (health.vo_status >= 0) {
@@ -331,6 +329,9 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // Health: what arrives on the bus, against what the scenario should produce;
   // the nodes' heartbeats say they are up and what they have done.
   auto bus = core::openBus(scenario.bus);
+  for (const auto& [channel, health] : channels) {
+    if (health.expected_hz > 0.0) bus->expectRate(channel, health.expected_hz);
+  }
   const auto bus_opened = Clock::now();
   std::map<std::string, NodeReport> heartbeats;  // by node name
   ForeignSimulator foreign;
@@ -365,10 +366,6 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     ChannelHealth& health = channels[std::string(raw.channel)];
     ++health.total;
     ++health.window;
-    if (const auto utime = core::peekUtime(raw)) {
-      if (!health.first_utime) health.first_utime = *utime;
-      health.last_utime = std::max(*utime, health.last_utime.value_or(*utime));
-    }
     if (msg::isType<msg::VoEstimate>(raw.data, raw.size)) {
       try {
         health.vo_status =
@@ -504,7 +501,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       if (window_s >= options.report_period_s) {
         last_report = now;
         printHealth(out, std::chrono::duration<double>(now - started).count(), window_s,
-                    scenario.time.speed, channels, heartbeats, nodes_by_host);
+                    scenario.time.speed, channels, bus->stats(), heartbeats, nodes_by_host);
         recording.update();
       }
     }
@@ -524,9 +521,10 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     if (!clean && result == 0) result = 1;
   }
   out << "launch: messages received\n";
+  const auto final_stats = bus->stats();
   for (const auto& [name, health] : channels) {
     out << "  " << name << ": " << health.total;
-    if (health.expected_hz > 0.0) out << " (" << health.missing() << " missing)";
+    if (health.expected_hz > 0.0) out << " (" << missingOn(final_stats, name) << " missing)";
     out << "\n";
   }
   if (!recordingHere()) {
