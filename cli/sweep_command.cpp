@@ -101,11 +101,13 @@ void writeResults(const run::SweepSpec& spec, const std::vector<run::SweepCell>&
 // Follows submitted jobs until the merge has run; then the merged table.
 void waitForSlurm(const run::SweepSpec& spec, const run::SlurmJobs& jobs) {
   ProgressLine line;
-  while (true) {
+  // The merge is over when squeue has not listed it twice running (one
+  // answer lost to a busy controller does not end the wait).
+  for (int quiet = 0; quiet < 2;) {
     const run::SlurmStatus status = run::slurmStatus(spec, selfProgram(), jobs);
     line.show(status.progress);
-    if (!status.merge_active) break;
-    std::this_thread::sleep_for(std::chrono::seconds(2));
+    quiet = status.merge_active ? 0 : quiet + 1;
+    if (quiet < 2) std::this_thread::sleep_for(std::chrono::seconds(2));
   }
   line.end();
   const fs::path results = fs::path(spec.out_dir) / "results.md";

@@ -267,6 +267,8 @@ SlurmStatus slurmStatus(const SweepSpec& spec, const std::string& nadir_program,
       ++p.failed;  // FAILED, TIMEOUT, CANCELLED, OUT_OF_MEMORY, NODE_FAIL, or no metrics
     } else if (state == states.end() && !jobs.array_job.empty()) {
       ++p.failed;  // not in the array's record and not done: gone without its metrics
+    } else {
+      ++p.pending;  // nothing submitted: not run yet
     }
   }
   // At the pace of the finished cells, with as many at once as run now.

@@ -334,6 +334,7 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
     if (on_progress) on_progress(progress);
     if (!running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
+  if (to_run.empty() && on_progress) on_progress(progress);  // every cell was done before
   return cells;
 }
 

@@ -118,10 +118,15 @@ inline PlaybackResult playAcrossHosts(const TestHosts& hosts, const PlaybackSetu
     for (auto& node : vo_nodes) node->stop(10.0);
   };
   recorder.start();
-  if (!waitFor(recorder, "Ctrl-C stops")) return stopAll(), result;
+  bool ready = waitFor(recorder, "Ctrl-C stops");
   for (auto& node : vo_nodes) {
+    if (!ready) break;
     node->start();
-    if (!waitFor(*node, "bus: ")) return stopAll(), result;
+    ready = waitFor(*node, "bus: ");
+  }
+  if (!ready) {
+    stopAll();
+    return result;
   }
   const auto play_started = Clock::now();
   const auto [status, output] = runCommand(
