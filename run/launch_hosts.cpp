@@ -1,6 +1,7 @@
 #include "run/launch_hosts.h"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -151,6 +152,16 @@ LaunchHosts loadLaunchHosts(const std::string& path, const std::vector<std::stri
         }
         for (const LaunchHost& other : parsed.hosts) {
           if (other.name == host.name) failAt(path, host_entry.first, where, "named twice");
+        }
+        // "launch" is the launch itself in the bus check, which lists hosts with commas.
+        const bool plain =
+            !host.name.empty() && std::all_of(host.name.begin(), host.name.end(), [](char c) {
+              return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
+                     c == '.';
+            });
+        if (!plain || host.name == "launch") {
+          failAt(path, host_entry.first, where,
+                 "a host's name is letters, digits, '-', '_' and '.', and not 'launch'");
         }
         parsed.hosts.push_back(std::move(host));
       }

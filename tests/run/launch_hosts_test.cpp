@@ -85,6 +85,8 @@ TEST(LaunchHosts, NamesWhatIsWrong) {
       {"hosts: {a: {prefix: x, user: pi}}\n", "hosts.a.user: unknown key (known: prefix, bin_dir)"},
       {"nodes: {sim: a}\n", "hosts: missing"},
       {"hosts: {a: {prefix: x}}\ndefault_host: c\n", "default_host: no host named 'c'"},
+      {"hosts: {launch: {prefix: x}}\n", "hosts.launch: a host's name is letters"},
+      {"hosts: {\"a,b\": {prefix: x}}\n", "hosts.a,b: a host's name is letters"},
   };
   for (const auto& [text, expected] : cases) {
     const fs::path file = writeFile(dir / "hosts.yaml", text);
