@@ -178,6 +178,7 @@ int runDoctor() {
   }
   results.push_back(checkReceiveBuffers(readInteger("/proc/sys/net/core/rmem_max"),
                                         readInteger("/proc/sys/net/core/rmem_default")));
+  results.push_back(checkExposure(url));
   results.push_back(checkUdpmSelfTest(url));
   results.push_back(checkHeadlessGl());
   results.push_back(versions());

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/bus.h"
+
 namespace nadir::cli {
 namespace {
 
@@ -142,6 +144,24 @@ std::vector<std::string> receiveBufferFix() {
   return {"sudo sysctl -w net.core.rmem_max=" + value + " net.core.rmem_default=" + value,
           "printf 'net.core.rmem_max=" + value + "\\nnet.core.rmem_default=" + value +
               "\\n' | sudo tee /etc/sysctl.d/60-nadir-lcm.conf   # keep it after reboot"};
+}
+
+CheckResult checkExposure(const std::string& url) {
+  const std::optional<int> ttl = core::udpmTtl(url);
+  if (!ttl) {
+    return {CheckStatus::kInfo, "exposure", url + ": not UDP multicast, nothing leaves by it", {}};
+  }
+  if (*ttl == 0) {
+    return {CheckStatus::kOk, "exposure", url + ": ttl=0, every message stays on this host", {}};
+  }
+  return {
+      CheckStatus::kWarn,
+      "exposure",
+      url + ": ttl=" + std::to_string(*ttl) + ", every message leaves this host" +
+          (*ttl > 1 ? " and crosses routers" : " for the local network") +
+          ", where anyone may read it and send on nadir's channels; keep ttl=0 unless "
+          "the nodes run on several machines",
+      {"unset LCM_DEFAULT_URL   # or: export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0'"}};
 }
 
 }  // namespace nadir::cli

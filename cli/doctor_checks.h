@@ -34,6 +34,11 @@ std::uint32_t parseIpv4(const std::string& dotted);
 std::string formatIpv4(std::uint32_t address);
 int prefixLength(std::uint32_t mask);
 
+// Does the bus nadir opens by default (LCM_DEFAULT_URL) leave this host?
+// ttl=0 keeps every message here; ttl >= 1 puts them on the network, where
+// anyone may read them and send on nadir's channels: a warning.
+CheckResult checkExposure(const std::string& url);
+
 // Is there a route for the LCM multicast group, and is it sane?
 CheckResult checkMulticastRoute(const std::vector<Ipv4Route>& routes, std::uint32_t group,
                                 bool loopback_has_multicast_flag);

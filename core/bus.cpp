@@ -1,5 +1,6 @@
 #include "core/bus.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <utility>
@@ -150,6 +151,26 @@ std::string defaultBusUrl() {
   const char* env = std::getenv("LCM_DEFAULT_URL");
   if (env != nullptr && *env != '\0') return env;
   return "udpm://239.255.76.67:7667?ttl=0";
+}
+
+std::optional<int> udpmTtl(const std::string& url) {
+  if (url.rfind("udpm://", 0) != 0) return std::nullopt;
+  const auto query = url.find('?');
+  if (query == std::string::npos) return 0;
+  std::size_t at = query + 1;
+  while (at < url.size()) {
+    const auto end = std::min(url.find('&', at), url.size());
+    if (url.compare(at, 4, "ttl=") == 0) {
+      const std::string value = url.substr(at + 4, end - at - 4);
+      if (value.empty() || value.find_first_not_of("0123456789") != std::string::npos ||
+          value.size() > 3) {
+        return std::nullopt;
+      }
+      return std::stoi(value);
+    }
+    at = end + 1;
+  }
+  return 0;
 }
 
 void BusParams::visit(ParamVisitor& v) {

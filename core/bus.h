@@ -161,6 +161,10 @@ std::unique_ptr<Bus> openBus(const BusParams& params);
 // The URL an empty url resolves to here.
 std::string defaultBusUrl();
 
+// A udpm:// URL's ttl (0 when it gives none, as LCM takes it: the messages
+// stay on this host); nothing for any other URL or a ttl that is no number.
+std::optional<int> udpmTtl(const std::string& url);
+
 // What stats say was lost, for a status line: "nothing lost on 7 channels" or
 // "lost CAMERA_DOWN 3 of 1863 (2 gaps), RANGE 1 of 400 (1 gap)". Channels
 // without a known rate (irregular, or too few messages yet) and ignore are left out.

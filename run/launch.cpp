@@ -133,10 +133,7 @@ struct ForeignSimulator {
 
 // Whether url sends nothing off this machine (udpm with ttl=0, or memq).
 bool staysOnThisHost(const std::string& url) {
-  if (url.rfind("memq://", 0) == 0) return true;
-  if (url.rfind("udpm://", 0) != 0) return false;
-  const auto ttl = url.find("ttl=");
-  return ttl == std::string::npos || url.compare(ttl, 5, "ttl=0") == 0;
+  return url.rfind("memq://", 0) == 0 || core::udpmTtl(url) == 0;
 }
 
 // The bus joins every host in use: a checker on each, and this launch, until

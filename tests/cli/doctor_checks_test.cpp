@@ -231,5 +231,21 @@ TEST(Ipv4, PrefixLength) {
   EXPECT_EQ(prefixLength(0xFFFFFFFFu), 32);
 }
 
+// A bus that leaves the host is a warning naming its ttl; ttl=0 (given or
+// not) stays here; a URL that is not udpm is only noted.
+TEST(CheckExposure, WarnsWhenTheBusLeavesTheHost) {
+  EXPECT_EQ(checkExposure("udpm://239.255.76.67:7667?ttl=0").status, CheckStatus::kOk);
+  EXPECT_EQ(checkExposure("udpm://239.255.76.67:7667").status, CheckStatus::kOk);
+  EXPECT_EQ(checkExposure("memq://").status, CheckStatus::kInfo);
+  const CheckResult link = checkExposure("udpm://239.255.76.67:7667?recv_buf_size=4096&ttl=1");
+  EXPECT_EQ(link.status, CheckStatus::kWarn);
+  EXPECT_NE(link.detail.find("ttl=1, every message leaves this host for the local network"),
+            std::string::npos)
+      << link.detail;
+  EXPECT_FALSE(link.fix.empty());
+  EXPECT_NE(checkExposure("udpm://239.255.76.67:7667?ttl=16").detail.find("crosses routers"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace nadir::cli

@@ -276,5 +276,18 @@ TEST(BusNetwork, UdpmRoundTripOnThisHost) {
   EXPECT_TRUE(thrown);
 }
 
+// A udpm URL's ttl: as given, 0 when none is (LCM's default), nothing for
+// another transport or a ttl that is no number.
+TEST(Bus, UdpmTtlIsReadFromTheUrl) {
+  EXPECT_EQ(udpmTtl("udpm://239.255.76.67:7667?ttl=1"), 1);
+  EXPECT_EQ(udpmTtl("udpm://239.255.76.67:7667?recv_buf_size=8&ttl=0"), 0);
+  EXPECT_EQ(udpmTtl("udpm://239.255.76.67:7667?recv_buf_size=8"), 0);
+  EXPECT_EQ(udpmTtl("udpm://239.255.76.67:7667"), 0);
+  EXPECT_EQ(udpmTtl("udpm://239.255.76.67:7667?ttl=255"), 255);
+  EXPECT_FALSE(udpmTtl("udpm://239.255.76.67:7667?ttl=x").has_value());
+  EXPECT_FALSE(udpmTtl("memq://").has_value());
+  EXPECT_FALSE(udpmTtl("file:///tmp/a.lcmlog?mode=w").has_value());
+}
+
 }  // namespace
 }  // namespace nadir::core
