@@ -46,13 +46,14 @@ int Bus::handleAvailable() {
 
 std::map<std::string, ChannelStats> Bus::stats() const {
   std::lock_guard lock(stats_mutex_);
-  std::map<std::string, ChannelStats> out(stats_.begin(), stats_.end());
-  for (const auto& [channel, gaps] : gaps_) {
-    ChannelStats& stats = out[channel];
-    stats.missing = gaps.missing();
-    stats.gaps = gaps.gaps();
-    stats.out_of_order = gaps.outOfOrder();
-    stats.rate_hz = gaps.rateHz();
+  std::map<std::string, ChannelStats> out;
+  for (const auto& [name, entry] : channels_) {
+    ChannelStats& stats = out[name] = entry.stats;
+    if (!entry.gaps) continue;
+    stats.missing = entry.gaps->missing();
+    stats.gaps = entry.gaps->gaps();
+    stats.out_of_order = entry.gaps->outOfOrder();
+    stats.rate_hz = entry.gaps->rateHz();
   }
   return out;
 }
@@ -60,7 +61,15 @@ std::map<std::string, ChannelStats> Bus::stats() const {
 void Bus::expectRate(const std::string& channel, double rate_hz) {
   std::lock_guard lock(stats_mutex_);
   expected_rates_[channel] = rate_hz;
-  if (auto it = gaps_.find(channel); it != gaps_.end()) it->second.expectRate(rate_hz);
+  if (auto it = channels_.find(channel); it != channels_.end() && it->second.gaps) {
+    it->second.gaps->expectRate(rate_hz);
+  }
+}
+
+Bus::Channel& Bus::channel(std::string_view name) {
+  auto it = channels_.find(name);
+  if (it == channels_.end()) it = channels_.emplace(std::string(name), Channel{}).first;
+  return it->second;
 }
 
 void Bus::publish(std::string_view channel, const void* data, std::size_t size,
@@ -78,30 +87,23 @@ std::map<std::string, std::int64_t> Bus::sent() const {
 }
 
 void Bus::countMessage(std::string_view channel, const void* data, std::size_t size) {
-  std::lock_guard lock(stats_mutex_);
-  auto it = stats_.find(channel);
-  if (it == stats_.end()) it = stats_.emplace(std::string(channel), ChannelStats{}).first;
-  ++it->second.messages;
-  it->second.bytes += size;
   const std::optional<std::int64_t> utime =
       peekUtime(RawMessage{channel, static_cast<const std::uint8_t*>(data), size, 0});
+  std::lock_guard lock(stats_mutex_);
+  Channel& entry = this->channel(channel);
+  ++entry.stats.messages;
+  entry.stats.bytes += size;
   if (!utime) return;
-  auto gaps = gaps_.find(channel);
-  if (gaps == gaps_.end()) {
+  if (!entry.gaps) {
     const auto rate = expected_rates_.find(channel);
-    gaps = gaps_
-               .emplace(std::string(channel),
-                        StreamGaps(rate == expected_rates_.end() ? 0.0 : rate->second))
-               .first;
+    entry.gaps.emplace(rate == expected_rates_.end() ? 0.0 : rate->second);
   }
-  gaps->second.add(*utime);
+  entry.gaps->add(*utime);
 }
 
 void Bus::countDecodeError(std::string_view channel) {
   std::lock_guard lock(stats_mutex_);
-  auto it = stats_.find(channel);
-  if (it == stats_.end()) it = stats_.emplace(std::string(channel), ChannelStats{}).first;
-  ++it->second.decode_errors;
+  ++this->channel(channel).stats.decode_errors;
 }
 
 std::string describeLosses(const std::map<std::string, ChannelStats>& stats,

@@ -126,8 +126,13 @@ class Bus {
   friend class Subscription;
   int next_id_ = 0;
   mutable std::mutex stats_mutex_;
-  std::map<std::string, ChannelStats, std::less<>> stats_;
-  std::map<std::string, StreamGaps, std::less<>> gaps_;
+  // A channel's counters and what it lost (its gaps once a message carried a time).
+  struct Channel {
+    ChannelStats stats;
+    std::optional<StreamGaps> gaps;
+  };
+  Channel& channel(std::string_view name);  // stats_mutex_ held
+  std::map<std::string, Channel, std::less<>> channels_;
   std::map<std::string, double, std::less<>> expected_rates_;
   std::map<std::string, std::int64_t, std::less<>> sent_;
 };

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/params.h"
+#include "run/process.h"
 #include "run/yaml_file.h"
 
 namespace nadir::run {
@@ -45,64 +46,11 @@ std::vector<std::string> LaunchHosts::command(const LaunchHost& on, std::vector<
   if (on.prefix.empty()) return argv;
   std::vector<std::string> command = on.prefix;
   if (on.viaSsh()) {
-    std::string line = "exec";
-    for (const std::string& word : argv) {
-      line.push_back(' ');
-      line.append(shellQuote(word));
-    }
-    command.push_back(line);
+    command.push_back("exec " + shellLine(argv));
   } else {
     command.insert(command.end(), argv.begin(), argv.end());
   }
   return command;
-}
-
-std::vector<std::string> splitWords(const std::string& text) {
-  std::vector<std::string> words;
-  std::string word;
-  bool in_word = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c == '\'' || c == '"') {
-      const std::size_t close = text.find(c, i + 1);
-      if (close == std::string::npos) {
-        throw std::invalid_argument("an unclosed " + std::string(1, c) + " in '" + text + "'");
-      }
-      word += text.substr(i + 1, close - i - 1);
-      in_word = true;
-      i = close;
-    } else if (c == '\\' && i + 1 < text.size()) {
-      word += text[++i];
-      in_word = true;
-    } else if (c == ' ' || c == '\t') {
-      if (in_word) words.push_back(word);
-      word.clear();
-      in_word = false;
-    } else {
-      word += c;
-      in_word = true;
-    }
-  }
-  if (in_word) words.push_back(word);
-  return words;
-}
-
-std::string shellQuote(const std::string& word) {
-  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0 ||
-           std::string("/._-=:,+@%").find(c) != std::string::npos;
-  });
-  if (plain) return word;
-  std::string quoted(1, '\'');
-  for (const char c : word) {
-    if (c == '\'') {
-      quoted.append("'\\''");
-    } else {
-      quoted.push_back(c);
-    }
-  }
-  quoted.push_back('\'');
-  return quoted;
 }
 
 LaunchHosts localHosts() {

@@ -52,10 +52,4 @@ LaunchHosts loadLaunchHosts(const std::string& path, const std::vector<std::stri
 // Every node on this machine: what launch does without --hosts.
 LaunchHosts localHosts();
 
-// Splits a prefix as a shell would split words (single and double quotes,
-// backslash); throws std::invalid_argument for an unclosed quote.
-std::vector<std::string> splitWords(const std::string& text);
-// One word for a POSIX shell: 'it''s' style quoting where needed.
-std::string shellQuote(const std::string& word);
-
 }  // namespace nadir::run

@@ -21,6 +21,14 @@ struct CommandOutput {
 };
 CommandOutput runAndCapture(const std::vector<std::string>& argv);
 
+// Splits text as a shell would split words (single and double quotes,
+// backslash); throws std::invalid_argument for an unclosed quote.
+std::vector<std::string> splitWords(const std::string& text);
+// One word for a POSIX shell: 'it'\''s' style quoting where needed.
+std::string shellQuote(const std::string& word);
+// Words as one line a POSIX shell splits back into the same words.
+std::string shellLine(const std::vector<std::string>& words);
+
 class ChildProcess {
  public:
   ChildProcess(std::string name, std::vector<std::string> argv, std::string log_path);

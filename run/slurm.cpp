@@ -8,22 +8,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "run/launch_hosts.h"
 #include "run/process.h"
 
 namespace nadir::run {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string quoted(const std::vector<std::string>& words) {
-  std::string line;
-  for (const std::string& word : words) {
-    if (!line.empty()) line.push_back(' ');
-    line.append(shellQuote(word));
-  }
-  return line;
-}
 
 std::string sweepName(const SweepSpec& spec) {
   return "nadir-sweep-" + fs::path(fs::absolute(spec.out_dir)).filename().string();
@@ -135,7 +125,7 @@ SlurmPlan writeSlurmScripts(const SweepSpec& spec, const std::vector<std::string
   const fs::path dir = out / "slurm";
   fs::create_directories(dir / "logs");
   plan.dir = dir.string();
-  const std::vector<SweepCell> cells = planSweep(spec);
+  std::vector<SweepCell> cells = planSweep(spec);
   for (std::size_t i = 0; i < cells.size(); ++i) {
     if (rerun || !cellDone(cells[i], cellCommand(spec, cells[i], nadir_program))) {
       plan.cells.push_back(i);
@@ -168,7 +158,7 @@ SlurmPlan writeSlurmScripts(const SweepSpec& spec, const std::vector<std::string
             "\n"
             "#SBATCH --output=" +
             (dir / "logs" / "cell_%a.out").string() + "\n" + sharedOptions(slurm) +
-            "set -euo pipefail\n" + "exec " + quoted(task) + " \"$SLURM_ARRAY_TASK_ID\"\n");
+            "set -euo pipefail\n" + "exec " + shellLine(task) + " \"$SLURM_ARRAY_TASK_ID\"\n");
   }
   std::vector<std::string> merge = sweep_command;
   merge.push_back("--tabulate");
@@ -185,7 +175,7 @@ SlurmPlan writeSlurmScripts(const SweepSpec& spec, const std::vector<std::string
                   "#SBATCH --time=00:30:00\n"
                   "#SBATCH --output=" +
                   (dir / "logs" / "merge.out").string() + "\n" + sharedOptions(slurm) +
-                  "set -euo pipefail\n" + "exec " + quoted(merge) + "\n");
+                  "set -euo pipefail\n" + "exec " + shellLine(merge) + "\n");
   plan.submit_script = (dir / "submit.sh").string();
   std::string submit =
       "#!/bin/bash\n"
@@ -242,7 +232,7 @@ SlurmJobs submittedJobs(const SweepSpec& spec) {
 SlurmStatus slurmStatus(const SweepSpec& spec, const std::string& nadir_program,
                         const SlurmJobs& jobs) {
   SlurmStatus status;
-  const std::vector<SweepCell> cells = planSweep(spec);
+  std::vector<SweepCell> cells = planSweep(spec);
   const std::map<std::size_t, std::string> states =
       jobs.array_job.empty() ? std::map<std::size_t, std::string>{}
                              : taskStates(jobs.array_job, &status.scheduler_note);

@@ -243,7 +243,7 @@ void prepareCell(const SweepCell& cell, const std::vector<std::string>& command)
 
 }  // namespace
 
-bool cellDone(const SweepCell& cell, const std::vector<std::string>& command) {
+bool cellDone(SweepCell& cell, const std::vector<std::string>& command) {
   std::ifstream in(commandFile(cell));
   if (!in) return false;
   std::stringstream recorded;
@@ -251,7 +251,9 @@ bool cellDone(const SweepCell& cell, const std::vector<std::string>& command) {
   if (recorded.str() != commandRecord(command)) return false;
   SweepCell read = cell;
   readCellMetrics(read);
-  return read.metrics.has_value();
+  if (!read.metrics) return false;
+  cell.metrics = std::move(read.metrics);
+  return true;
 }
 
 int runCell(const SweepSpec& spec, std::size_t index, const std::string& nadir_program) {
@@ -282,7 +284,6 @@ std::vector<SweepCell> runSweep(const SweepSpec& spec, const std::string& nadir_
   std::vector<std::size_t> to_run;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     if (!rerun && cellDone(cells[i], cellCommand(spec, cells[i], nadir_program))) {
-      readCellMetrics(cells[i]);
       cells[i].exit_status = 0;
       ++progress.done_before;
     } else {

@@ -104,8 +104,9 @@ std::string describeProgress(const SweepProgress& progress);
 // The `nadir run` command of a cell (argv[0] = nadir_program).
 std::vector<std::string> cellCommand(const SweepSpec& spec, const SweepCell& cell,
                                      const std::string& nadir_program);
-// True when the cell's metrics.json reads and sweep_cell.txt holds command.
-bool cellDone(const SweepCell& cell, const std::vector<std::string>& command);
+// True when the cell's metrics.json reads (they are then in cell.metrics) and
+// sweep_cell.txt holds command; a cell not done is left as it was.
+bool cellDone(SweepCell& cell, const std::vector<std::string>& command);
 
 // Runs one cell now, in this process's child (what a Slurm array task does):
 // sweep_cell.txt written, an earlier metrics.json removed, output in
