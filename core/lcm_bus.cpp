@@ -7,6 +7,9 @@
 #include <utility>
 
 namespace nadir::core {
+namespace {
+constexpr int kCounterQueueFactor = 100;
+}  // namespace
 
 struct LcmBus::Entry {
   LcmBus* bus;
@@ -22,7 +25,10 @@ LcmBus::LcmBus(const std::string& url, int queue_capacity)
                    "' (for udpm://, a multicast route is needed: run `nadir doctor`)");
   }
   counter_ = lcm_subscribe(lcm_, ".*", &LcmBus::onAnyMessage, this);
-  lcm_subscription_set_queue_capacity(counter_, queue_capacity_);
+  // The counter queues every channel's messages, a node's subscription one
+  // channel's: with the same capacity it would drop first while the node
+  // lags and count losses the node never had.
+  lcm_subscription_set_queue_capacity(counter_, kCounterQueueFactor * queue_capacity_);
 }
 
 LcmBus::~LcmBus() {
