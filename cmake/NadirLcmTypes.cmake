@@ -1,5 +1,6 @@
 # nadir_add_lcmtypes(<target> <file.lcm>...)
-# Generates C++ headers with `lcm-gen -x` into the build tree and exposes them
+# Generates C++ headers with `lcm-gen -x` into the build tree (their decode()
+# guarded against impossible counts: NadirLcmDecodeGuard.cmake) and exposes them
 # through an INTERFACE target. Debian's LCM 1.3.1 has no lcmUtilities.cmake.
 function(nadir_add_lcmtypes target)
   set(include_dir ${CMAKE_CURRENT_BINARY_DIR}/include)
@@ -16,7 +17,8 @@ function(nadir_add_lcmtypes target)
     add_custom_command(
       OUTPUT ${header}
       COMMAND ${LCM_GEN_EXECUTABLE} -x --cpp-hpath ${include_dir} ${abs_file}
-      DEPENDS ${abs_file}
+      COMMAND ${CMAKE_COMMAND} -DHEADER=${header} -P ${PROJECT_SOURCE_DIR}/cmake/NadirLcmDecodeGuard.cmake
+      DEPENDS ${abs_file} ${PROJECT_SOURCE_DIR}/cmake/NadirLcmDecodeGuard.cmake
       COMMENT "lcm-gen ${type_name}"
       VERBATIM)
     list(APPEND headers ${header})

@@ -13,6 +13,9 @@ constexpr double kBeatTolerance = 0.25;
 // A step back by more than this many periods is a new start (a log looped or
 // seeked), counted from there; a smaller one is a message out of order.
 constexpr double kRestartPeriods = 2.0;
+// A step forward by more than this is no loss either but a time from elsewhere
+// (a foreign or corrupt message, a clock set): a new start, like a step back.
+constexpr double kMaxStep_us = 3600e6;
 
 }  // namespace
 
@@ -43,17 +46,21 @@ void StreamGaps::add(std::int64_t utime) {
 }
 
 void StreamGaps::count(std::int64_t utime) {
-  if (last_utime_ && utime <= *last_utime_) {
-    ++out_of_order_;
-    if (period_us_ > 0.0 &&
-        static_cast<double>(*last_utime_ - utime) > kRestartPeriods * period_us_) {
-      last_utime_ = utime;
-    }
+  if (!last_utime_) {
+    last_utime_ = utime;
     return;
   }
-  if (last_utime_ && period_us_ > 0.0) {
-    const double periods = static_cast<double>(utime - *last_utime_) / period_us_;
-    const auto lost = static_cast<std::int64_t>(std::llround(periods)) - 1;
+  // In double: the times of a foreign message are any 64 bits.
+  const double step_us = static_cast<double>(utime) - static_cast<double>(*last_utime_);
+  if (step_us <= 0.0) {
+    ++out_of_order_;
+    if (period_us_ > 0.0 && -step_us > kRestartPeriods * period_us_) last_utime_ = utime;
+    return;
+  }
+  if (step_us > kMaxStep_us) {
+    ++out_of_order_;
+  } else if (period_us_ > 0.0) {
+    const auto lost = static_cast<std::int64_t>(std::llround(step_us / period_us_)) - 1;
     if (lost > 0) {
       missing_ += lost;
       ++gaps_;
@@ -65,8 +72,9 @@ void StreamGaps::count(std::int64_t utime) {
 void StreamGaps::learn() {
   std::vector<double> intervals;
   for (std::size_t i = 1; i < first_times_.size(); ++i) {
-    const std::int64_t interval = first_times_[i] - first_times_[i - 1];
-    if (interval > 0) intervals.push_back(static_cast<double>(interval));
+    const double interval =
+        static_cast<double>(first_times_[i]) - static_cast<double>(first_times_[i - 1]);
+    if (interval > 0.0 && interval <= kMaxStep_us) intervals.push_back(interval);
   }
   std::vector<double> sorted = intervals;
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2),

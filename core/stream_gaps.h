@@ -28,7 +28,9 @@ class StreamGaps {
   std::int64_t missing() const { return missing_; }
   // Places where one or more were lost.
   std::int64_t gaps() const { return gaps_; }
-  // Messages at or before the time of the one before (repeats, a log looped or seeked).
+  // Messages at or before the time of the one before (repeats, a log looped or
+  // seeked), or more than an hour after it (a time from elsewhere: a foreign or
+  // corrupt message); neither counts as a loss.
   std::int64_t outOfOrder() const { return out_of_order_; }
   // The period counted with: given or learnt; 0 while not known or when irregular.
   double rateHz() const;

@@ -181,7 +181,11 @@ Trajectory readFlightCsv(const std::string& path, const LocalNedFrame& frame) {
   if (!std::getline(in, line)) throw TrajectoryError(path + ": empty file, expected a header");
   const std::vector<std::string> header = splitCsv(line);
   std::map<std::string, std::size_t> column;
-  for (std::size_t i = 0; i < header.size(); ++i) column[header[i]] = i;
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (!column.emplace(header[i], i).second && !header[i].empty()) {
+      throw TrajectoryError(path + ": the header names column '" + header[i] + "' twice");
+    }
+  }
   for (const char* name :
        {"time_s", "lat_deg", "lon_deg", "alt_m", "roll_deg", "pitch_deg", "yaw_deg"}) {
     if (column.count(name) == 0) {
@@ -216,9 +220,18 @@ Trajectory readFlightCsv(const std::string& path, const LocalNedFrame& frame) {
       }
       return number;
     };
-    const Geodetic point = geodeticFromDegrees(value("lat_deg"), value("lon_deg"), value("alt_m"));
+    const double lat_deg = value("lat_deg");
+    if (std::abs(lat_deg) > 90.0) {
+      throw TrajectoryError(where + ": lat_deg " + fields[column.at("lat_deg")] +
+                            " is outside [-90, 90]");
+    }
+    const Eigen::Vector3d p_ned_m =
+        frame.nedFromGeodetic(geodeticFromDegrees(lat_deg, value("lon_deg"), value("alt_m")));
+    if (!p_ned_m.allFinite()) {
+      throw TrajectoryError(where + ": the position is too far from the frame's origin to hold");
+    }
     trajectory.push_back(
-        {value("time_s"), frame.nedFromGeodetic(point),
+        {value("time_s"), p_ned_m,
          quaternionFromRpy({value("roll_deg") * kRadPerDeg, value("pitch_deg") * kRadPerDeg,
                             value("yaw_deg") * kRadPerDeg})});
   }

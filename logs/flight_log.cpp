@@ -81,13 +81,18 @@ std::optional<T> decodeCounted(const core::LogEvent& event, FlightLogStats& stat
   return std::nullopt;
 }
 
+// Seconds from origin_utime to utime, in double: a log's times are any 64 bits
+// (exact for the times of a real flight, below 2^53 us).
+double secondsAfter(std::int64_t utime, std::int64_t origin_utime) {
+  return (static_cast<double>(utime) - static_cast<double>(origin_utime)) / 1e6;
+}
+
 // Stamps are seconds after origin_utime: near the epoch, absolute seconds would
 // keep only a quarter of a microsecond.
 core::Trajectory toTrajectory(const std::vector<TimedPose>& poses, std::int64_t origin_utime = 0) {
   core::Trajectory trajectory;
   for (const TimedPose& pose : poses) {
-    trajectory.push_back(
-        {core::stampFromUtime(pose.utime - origin_utime), pose.p_ned_m, pose.q_world_body});
+    trajectory.push_back({secondsAfter(pose.utime, origin_utime), pose.p_ned_m, pose.q_world_body});
   }
   return trajectory;
 }
@@ -102,13 +107,18 @@ std::vector<TimedPose> pairPositions(const std::vector<TimedPosition>& positions
   std::vector<TimedPose> poses;
   for (const TimedPosition& position : positions) {
     const std::optional<core::StampedPose> attitude =
-        core::interpolate(attitude_track, core::stampFromUtime(position.utime - origin_utime));
+        core::interpolate(attitude_track, secondsAfter(position.utime, origin_utime));
     if (!attitude) {
       ++stats.positions_outside_attitude_span;
       continue;
     }
-    poses.push_back(
-        {position.utime, frame.nedFromGeodetic(position.point), attitude->q_world_body});
+    // A height no flight has (found by fuzzing: 1e300 m) is no position in the frame.
+    const Eigen::Vector3d p_ned_m = frame.nedFromGeodetic(position.point);
+    if (!p_ned_m.allFinite()) {
+      ++stats.invalid_messages;
+      continue;
+    }
+    poses.push_back({position.utime, p_ned_m, attitude->q_world_body});
   }
   return poses;
 }

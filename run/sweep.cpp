@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,23 @@ namespace fs = std::filesystem;
 std::string lastPart(const std::string& key) {
   const auto dot = key.rfind('.');
   return dot == std::string::npos ? key : key.substr(dot + 1);
+}
+
+constexpr std::size_t kMaxCellNameBytes = 200;
+// More runs than anyone flies in one sweep: a typing slip, refused before the
+// plan of its cells fills the memory.
+constexpr double kMaxCells = 100000;
+
+// Text as part of a folder name: letters, digits and ._+-= kept, anything else
+// (a '/', a space) '_'. The cell's number keeps two names apart.
+std::string folderSafe(const std::string& text) {
+  std::string safe = text;
+  for (char& c : safe) {
+    if (std::isalnum(static_cast<unsigned char>(c)) == 0 &&
+        std::string_view("._+-=").find(c) == std::string_view::npos)
+      c = '_';
+  }
+  return safe;
 }
 
 // The sources any cell reports, in name order.
@@ -153,6 +171,18 @@ SweepSpec loadSweep(const std::string& path) {
   }
   if (spec.scenario.empty()) throw core::ParamError(path + ": scenario: missing");
   if (spec.axes.empty()) throw core::ParamError(path + ": axes: missing (nothing to sweep)");
+  double cells = 1.0;
+  for (const SweepAxis& axis : spec.axes) {
+    if (axis.values.empty()) {
+      throw core::ParamError(path + ": axes." + axis.key + ": no values (nothing to sweep)");
+    }
+    cells *= static_cast<double>(axis.values.size());
+  }
+  if (cells > kMaxCells) {
+    throw core::ParamError(path + ": axes: " + std::to_string(static_cast<long long>(cells)) +
+                           " cells, more than a sweep plans (" +
+                           std::to_string(static_cast<long long>(kMaxCells)) + ")");
+  }
   return spec;
 }
 
@@ -175,10 +205,12 @@ std::vector<SweepCell> planSweep(const SweepSpec& spec) {
     std::string name = std::string("cell_") + index;
     for (std::size_t a = 0; a < spec.axes.size(); ++a) {
       name.append(1, '_')
-          .append(lastPart(spec.axes[a].key))
+          .append(folderSafe(lastPart(spec.axes[a].key)))
           .append(1, '=')
-          .append(cells[i].values[a]);
+          .append(folderSafe(cells[i].values[a]));
     }
+    // Within a file name's 255 bytes, with room for the sweep's own suffixes.
+    if (name.size() > kMaxCellNameBytes) name.resize(kMaxCellNameBytes);
     cells[i].out_dir = (fs::path(spec.out_dir) / name).string();
   }
   return cells;

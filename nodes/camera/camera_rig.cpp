@@ -64,7 +64,9 @@ CameraRig::CameraRig(render::TerrainRenderer& terrain,
                      const std::map<std::string, CameraSpec>& cameras)
     : specs_(cameras) {
   if (specs_.empty()) throw std::invalid_argument("the camera rig has no camera");
-  for (auto& [name, spec] : specs_) {
+  for (auto& entry : specs_) {
+    const std::string& name = entry.first;
+    CameraSpec& spec = entry.second;
     core::validateParams([&spec](core::ParamVisitor& v) { spec.visit(v); }, "cameras." + name);
     Camera camera;
     camera.renderer = std::make_unique<render::CameraRenderer>(terrain, spec.camera);

@@ -119,10 +119,8 @@ class Simulator {
   std::vector<DriveInput> pending_commands_;
   std::optional<DriveInput> applied_command_;
   bool rover_moved_ = false;
-  // The truth's recent positions (for a fix's error at its time) and the
-  // waypoint the guidance heads for.
+  // The truth's recent positions (for a fix's error at its time).
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> recent_truth_;
-  std::size_t next_waypoint_ = 0;
   Eigen::Vector3d position_error_m_ = Eigen::Vector3d::Zero();
   bool has_source_fix_ = false;
   void setPositionError(const Eigen::Vector3d& error_m);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/bus.h"
@@ -85,6 +86,29 @@ TEST(StreamGaps, ALoopIsANewStartAndALateMessageIsOutOfOrder) {
   for (const std::int64_t t : {0, 10000, 30000, 20000, 40000}) late.add(t);
   EXPECT_EQ(late.outOfOrder(), 1);
   EXPECT_EQ(late.missing(), 1);
+}
+
+// A message whose time is any 64 bits (a foreign or corrupt one, found by the
+// sanitizer build: the difference overflowed) is no loss. At 100 Hz: 0..40 ms,
+// a time near the end of int64 (more than an hour ahead: out of order), 50 ms
+// (a step back: out of order, a new start), 60 ms, a time near the start of
+// int64 (back: out of order), 70 ms (more than an hour ahead: out of order),
+// 80 ms. Nothing is missing.
+TEST(StreamGaps, ATimeFromElsewhereIsNoLoss) {
+  constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min();
+  StreamGaps gaps(100.0);
+  for (const std::int64_t t :
+       {0L, 10000L, 20000L, 30000L, 40000L, kMax - 5, 50000L, 60000L, kMin + 5, 70000L, 80000L}) {
+    gaps.add(t);
+  }
+  EXPECT_EQ(gaps.missing(), 0);
+  EXPECT_EQ(gaps.gaps(), 0);
+  EXPECT_EQ(gaps.outOfOrder(), 4);
+  // While learning, a wild time is left out of the intervals the rate comes from.
+  StreamGaps learnt;
+  for (int k = 0; k <= StreamGaps::kLearnIntervals; ++k) learnt.add(k == 8 ? kMax : k * 10000);
+  EXPECT_NEAR(learnt.rateHz(), 100.0, 1e-9);
 }
 
 // The bus counts gaps per channel from every message it receives, at the

@@ -269,6 +269,28 @@ TEST(Codec, MalformedImagesAreRefused) {
   EXPECT_NE(invalidReason<Image>(bad_jpeg).find("JPEG"), std::string::npos);
 }
 
+// A count or string length in the bytes that the bytes cannot hold is a
+// DecodeError, before anything is allocated for it: image_t's pixel count at
+// byte 32 (hash 8, utime 8, four int32) set to 2^31 - 1 and to -5, and
+// vo_estimate_t's source length at byte 16 (hash, utime) set to 0 and -1.
+TEST(Codec, ImpossibleCountsAreDecodeErrors) {
+  const auto withInt32At = [](Bytes bytes, std::size_t offset, std::int32_t value) {
+    const auto u = static_cast<std::uint32_t>(value);
+    for (int i = 0; i < 4; ++i) bytes[offset + i] = static_cast<std::uint8_t>(u >> (24 - 8 * i));
+    return bytes;
+  };
+  const Bytes image = encode(Image{0, gradient(1), 0, {}});
+  ASSERT_EQ(asLcm<nadir::image_t>(image).size, static_cast<std::int32_t>(image.size()) - 40);
+  EXPECT_THROW(decode<Image>(withInt32At(image, 32, 0x7fffffff)), DecodeError);
+  EXPECT_THROW(decode<Image>(withInt32At(image, 32, -5)), DecodeError);
+  VoEstimate estimate;
+  estimate.source = "ppa";
+  const Bytes vo = encode(estimate);
+  EXPECT_EQ(decode<VoEstimate>(withInt32At(vo, 16, 4)).source, "ppa");
+  EXPECT_THROW(decode<VoEstimate>(withInt32At(vo, 16, 0)), DecodeError);
+  EXPECT_THROW(decode<VoEstimate>(withInt32At(vo, 16, -1)), DecodeError);
+}
+
 // ---------------------------------------------------------------- camera_info_t
 
 // camera_info_t's fields are the struct's, and a lens that cannot be one is refused.

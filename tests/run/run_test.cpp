@@ -328,6 +328,56 @@ TEST(Sweep, BadFilesAreRefused) {
   EXPECT_THROW(loadSweep(path), core::ParamError);
 }
 
+// Found by fuzzing (fuzz/regressions/sweep): a '/' in an axis key or value
+// put a cell's folder elsewhere than the sweep's. Cell folders keep letters,
+// digits and ._+-=, anything else becomes '_', and stay under 200 bytes.
+TEST(Sweep, CellFoldersStayInTheSweepsFolder) {
+  const std::string dir = tempDir("sweep_folders");
+  fs::create_directories(dir);
+  const std::string path = (fs::path(dir) / "sweep.yaml").string();
+  std::ofstream(path) << "scenario: box\nout: " << dir
+                      << "\naxes:\n"
+                         "  vehicle./airspeed_mps: [10]\n"
+                         "  camera.calibration_file: [../../etc/lens.yaml, \"a b\", "
+                      << std::string(300, 'x') << "]\n";
+  const std::vector<SweepCell> cells = planSweep(loadSweep(path));
+  ASSERT_EQ(cells.size(), 3u);
+  EXPECT_EQ(fs::path(cells[0].out_dir).filename(),
+            "cell_000__airspeed_mps=10_calibration_file=.._.._etc_lens.yaml");
+  EXPECT_EQ(fs::path(cells[1].out_dir).filename(),
+            "cell_001__airspeed_mps=10_calibration_file=a_b");
+  EXPECT_EQ(fs::path(cells[2].out_dir).filename().string().size(), 200u);
+  for (const SweepCell& cell : cells) EXPECT_EQ(fs::path(cell.out_dir).parent_path(), dir);
+}
+
+// A sweep of more cells than anyone flies (ten axes of ten values: 10^10) and
+// an axis of no named variants are refused before anything is planned.
+TEST(Sweep, ImpossibleGridsAreRefused) {
+  const std::string dir = tempDir("sweep_huge");
+  fs::create_directories(dir);
+  const std::string path = (fs::path(dir) / "sweep.yaml").string();
+  std::ofstream huge(path);
+  huge << "scenario: box\naxes:\n";
+  for (int axis = 0; axis < 10; ++axis) huge << "  a" << axis << ".x: [0,1,2,3,4,5,6,7,8,9]\n";
+  huge.close();
+  try {
+    loadSweep(path);
+    FAIL() << "no error";
+  } catch (const core::ParamError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find(path + ": axes: 10000000000 cells, more than a sweep plans (100000)"),
+              std::string::npos)
+        << error.what();
+  }
+  std::ofstream(path, std::ios::trunc) << "scenario: box\naxes:\n  effect: {}\n";
+  try {
+    loadSweep(path);
+    FAIL() << "no error";
+  } catch (const core::ParamError& error) {
+    EXPECT_NE(std::string(error.what()).find("axes.effect"), std::string::npos) << error.what();
+  }
+}
+
 eval::SourceMetrics sourceMetrics(bool initialised, double position, double rotation,
                                   double tracked) {
   eval::SourceMetrics metrics{};

@@ -165,8 +165,10 @@ TEST(GateControllerTest, ASlalomBoardTurnsTheRoverToItsSide) {
   params.slalom.trigger_m = 1.3;
   params.slalom.turn_deg = 30.0;
   params.slalom.straight_m = 0.0;
-  for (const auto& [kind, side] :
+  for (const auto& entry :
        {std::pair{Pattern::kSlalomRight, 1.0}, std::pair{Pattern::kSlalomLeft, -1.0}}) {
+    const Pattern kind = entry.first;
+    const double side = entry.second;
     GateController controller(params);
     const auto board = [&](std::int64_t utime, double distance_m) {
       return slalomBoard(kind, side, utime, distance_m, 0.5);
@@ -214,8 +216,10 @@ TEST(GateControllerTest, ATurnBoardTurnsTheRoverAndGoesOn) {
   params.cruise_speed_mps = 2.0;
   params.max_lateral_acceleration_mps2 = 10.0;
   params.slalom.trigger_m = 0.8;
-  for (const auto& [kind, side] :
+  for (const auto& entry :
        {std::pair{Pattern::kSlalomRight, 1.0}, std::pair{Pattern::kSlalomLeft, -1.0}}) {
+    const Pattern kind = entry.first;
+    const double side = entry.second;
     GateController controller(params);
     const auto board = [&](std::int64_t utime, double distance_m) {
       return slalomBoard(kind, side, utime, distance_m, 0.75);

@@ -20,7 +20,6 @@ namespace nadir::sim {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kImuRate_hz = 200.0;
 constexpr std::int64_t kImuStep_us = 5000;
 
 const core::LocalNedFrame kFrame(core::Geodetic{39.3 * kDeg, -86.0 * kDeg, 250.0});

@@ -127,6 +127,22 @@ TEST(FlightReplay, BadInputIsRefusedWithItsPlace) {
                                            "deg\n0,37.3,-113,1500,0,0,0\n1,37.3,-113,abc,0,0,0\n");
   EXPECT_NE(message([&] { core::readFlightCsv(bad_number, frame); }).find("bad.csv:3: 'abc'"),
             std::string::npos);
+  // Found by fuzzing (fuzz/regressions/trajectory): a latitude past a pole
+  // threw std::invalid_argument, without the file; a column named twice was
+  // read from its last place.
+  const std::string pole = writeFile("pole.csv",
+                                     "time_s,lat_deg,lon_deg,alt_m,roll_deg,pitch_deg,yaw_deg\n"
+                                     "0,113.0,-113,1500,0,0,0\n");
+  EXPECT_NE(message([&] {
+              core::readFlightCsv(pole, frame);
+            }).find("pole.csv:2: lat_deg 113.0 is outside [-90, 90]"),
+            std::string::npos);
+  const std::string twice =
+      writeFile("twice.csv", "time_s,lat_deg,lon_deg,alt_m,roll_deg,lon_deg,pitch_deg,yaw_deg\n");
+  EXPECT_NE(message([&] {
+              core::readFlightCsv(twice, frame);
+            }).find("twice.csv: the header names column 'lon_deg' twice"),
+            std::string::npos);
   EXPECT_NE(message([&] { core::readTum("/nonexistent/x.tum"); }).find("/nonexistent/x.tum"),
             std::string::npos);
 }
