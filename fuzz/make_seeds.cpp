@@ -1,7 +1,8 @@
 // Writes the fuzz targets' seed corpora (docs/reliability.md): one encoded
 // message of each type, small LCM logs of a short flight, and small rasters cut
 // from the real files in tests/data/terrain with their georeferencing. A seed
-// for a target whose first byte picks the reader starts with that byte.
+// for a target whose first byte picks the reader starts with that byte; logs
+// have no .lcmlog ending (the repository ignores those).
 //   nadir-fuzz-seeds tests/data/terrain fuzz/corpus
 #include <cmath>
 #include <cstdio>
@@ -239,8 +240,8 @@ int main(int argc, char** argv) {
   writeMessages(corpus / "messages");
   fs::create_directories(corpus / "lcm_log");
   fs::create_directories(corpus / "flight_log");
-  writeFlightLog(corpus / "lcm_log" / "flight.lcmlog", true);
-  writeFlightLog(corpus / "flight_log" / "run.lcmlog", true);
-  writeFlightLog(corpus / "flight_log" / "navigator.lcmlog", false);
+  writeFlightLog(corpus / "lcm_log" / "flight", true);
+  writeFlightLog(corpus / "flight_log" / "run", true);
+  writeFlightLog(corpus / "flight_log" / "navigator", false);
   return 0;
 }
