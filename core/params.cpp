@@ -194,7 +194,7 @@ class YamlApplier final : public ParamVisitor {
     const std::vector<std::string> existing = access.names();
     std::vector<std::string> seen;
     for (const auto& entry : node) {
-      const std::string name = entry.first.as<std::string>();
+      const std::string name = keyText(entry.first, full_key);
       const std::string entry_key = joinKey(full_key, name);
       if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
         fail(whereIs(entry.first), entry_key, "given twice");
@@ -220,7 +220,7 @@ class YamlApplier final : public ParamVisitor {
   void rejectUnknownKeys() const {
     std::vector<std::string> seen;
     for (const auto& entry : map_) {
-      const std::string key = entry.first.as<std::string>();
+      const std::string key = keyText(entry.first, prefix_);
       if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
         fail(whereIs(entry.first), joinKey(prefix_, key), "given twice");
       }
@@ -234,6 +234,16 @@ class YamlApplier final : public ParamVisitor {
   }
 
  private:
+  // A map key as text; a key that is a list or a map (YAML's "? [a, b]") is an error.
+  std::string keyText(const YAML::Node& key, const std::string& within) const {
+    if (!key.IsScalar()) {
+      const std::string problem = "a key must be a name, not a list or a map";
+      if (within.empty()) throw ParamError(whereIs(key) + ": " + problem);
+      fail(whereIs(key), within, problem);
+    }
+    return key.Scalar();
+  }
+
   std::string whereIs(const YAML::Node& node) const {
     if (!with_lines_ || node.Mark().is_null()) return source_;
     return source_ + ":" + std::to_string(node.Mark().line + 1);

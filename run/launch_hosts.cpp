@@ -66,7 +66,7 @@ LaunchHosts loadLaunchHosts(const std::string& path, const std::vector<std::stri
   LaunchHosts parsed;
   std::optional<YAML::Node> nodes, default_host;
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = keyText(path, entry.first, "hosts file");
     const YAML::Node& value = entry.second;
     if (key == "hosts") {
       if (!value.IsMap() || value.size() == 0) {
@@ -74,12 +74,12 @@ LaunchHosts loadLaunchHosts(const std::string& path, const std::vector<std::stri
       }
       for (const auto& host_entry : value) {
         LaunchHost host;
-        host.name = host_entry.first.as<std::string>();
+        host.name = keyText(path, host_entry.first, "hosts");
         const std::string where = "hosts." + host.name;
         const YAML::Node& fields = host_entry.second;
         if (!fields.IsMap()) failAt(path, fields, where, "expected a map (prefix, bin_dir)");
         for (const auto& field : fields) {
-          const std::string name = field.first.as<std::string>();
+          const std::string name = keyText(path, field.first, where);
           try {
             if (name == "prefix") {
               if (field.second.IsSequence()) {
@@ -138,7 +138,7 @@ LaunchHosts loadLaunchHosts(const std::string& path, const std::vector<std::stri
     std::vector<std::string> known = node_names;
     known.push_back(kLoggerNode);
     for (const auto& placed : *nodes) {
-      const std::string node = placed.first.as<std::string>();
+      const std::string node = keyText(path, placed.first, "nodes");
       if (std::find(known.begin(), known.end(), node) == known.end()) {
         std::string names;
         for (const std::string& name : known) names += (names.empty() ? "" : ", ") + name;

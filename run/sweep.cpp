@@ -87,7 +87,7 @@ SweepSpec loadSweep(const std::string& path) {
     throw core::ParamError(path + ": expected a map (scenario, out, jobs, set, axes)");
   SweepSpec spec;
   for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = keyText(path, entry.first, "sweep file");
     const YAML::Node& value = entry.second;
     try {
       if (key == "scenario") {
@@ -103,7 +103,7 @@ SweepSpec loadSweep(const std::string& path) {
         if (!value.IsMap())
           failAt(path, value, key, "expected a map (cpus_per_task, mem, time, ...)");
         for (const auto& field : value) {
-          const std::string name = field.first.as<std::string>();
+          const std::string name = keyText(path, field.first, "slurm");
           const std::string where = "slurm." + name;
           try {
             if (name == "cpus_per_task") {
@@ -133,11 +133,11 @@ SweepSpec loadSweep(const std::string& path) {
       } else if (key == "axes") {
         if (!value.IsMap()) failAt(path, value, key, "expected a map of key: [values]");
         for (const auto& axis : value) {
-          SweepAxis parsed{axis.first.as<std::string>(), {}, {}};
+          SweepAxis parsed{keyText(path, axis.first, "axes"), {}, {}};
           const std::string where = "axes." + parsed.key;
           if (axis.second.IsMap() && axis.second.size() > 0) {
             for (const auto& variant : axis.second) {
-              const std::string name = variant.first.as<std::string>();
+              const std::string name = keyText(path, variant.first, where);
               if (!variant.second.IsSequence())
                 failAt(path, variant.second, where + "." + name, "expected a list of key=value");
               std::vector<std::string> overrides;

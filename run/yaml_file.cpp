@@ -22,4 +22,9 @@ void failAt(const std::string& path, const YAML::Node& node, const std::string& 
   throw core::ParamError(where + ": " + key + ": " + problem);
 }
 
+std::string keyText(const std::string& path, const YAML::Node& key, const std::string& within) {
+  if (!key.IsScalar()) failAt(path, key, within, "a key must be a name, not a list or a map");
+  return key.Scalar();
+}
+
 }  // namespace nadir::run

@@ -12,6 +12,10 @@ namespace nadir::run {
 // "PATH:LINE: not valid YAML: ...").
 YAML::Node loadYamlFile(const std::string& path, const std::string& what);
 
+// A map key as text; throws core::ParamError naming where and within when the
+// key is a list or a map (YAML's "? [a, b]").
+std::string keyText(const std::string& path, const YAML::Node& key, const std::string& within);
+
 // Throws core::ParamError "PATH:LINE: KEY: PROBLEM".
 [[noreturn]] void failAt(const std::string& path, const YAML::Node& node, const std::string& key,
                          const std::string& problem);

@@ -558,6 +558,19 @@ TEST(ParamsYaml, DuplicateKeyIsRejected) {
                  "test.yaml:3: camera.fps: given twice"));
 }
 
+// A key that is a list or a map (YAML's "? - x") is an error naming its line
+// and the group it is in (found by fuzzing: yaml-cpp's conversion error ended
+// the program, fuzz/regressions/scenario).
+TEST(ParamsYaml, AKeyThatIsAListIsRejected) {
+  VehicleParams params;
+  const std::string top = paramErrorOf([&] { applyText(params, "name: a\n? - [0, 600]\n: 1\n"); });
+  EXPECT_TRUE(startsWith(top, "test.yaml:2: ")) << top;
+  EXPECT_NE(top.find("a key must be a name, not a list or a map"), std::string::npos) << top;
+  const std::string inner =
+      paramErrorOf([&] { applyText(params, "camera:\n  ? [fps]\n  : 10\n"); });
+  EXPECT_TRUE(startsWith(inner, "test.yaml:2: camera: a key must be a name")) << inner;
+}
+
 // A document with one bad entry changes no field, including those before the bad one.
 TEST(ParamsYaml, BadDocumentChangesNothing) {
   VehicleParams params;
