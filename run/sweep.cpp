@@ -33,7 +33,7 @@ std::string lastPart(const std::string& key) {
 constexpr std::size_t kMaxCellNameBytes = 200;
 // More runs than anyone flies in one sweep: a typing slip, refused before the
 // plan of its cells fills the memory.
-constexpr double kMaxCells = 100000;
+constexpr double kMaxCells = 10000;
 
 // Text as part of a folder name: letters, digits and ._+-= kept, anything else
 // (a '/', a space) '_'. The cell's number keeps two names apart.
@@ -86,8 +86,10 @@ SweepSpec loadSweep(const std::string& path) {
   if (!root.IsMap())
     throw core::ParamError(path + ": expected a map (scenario, out, jobs, set, axes)");
   SweepSpec spec;
+  std::set<std::string> seen;
   for (const auto& entry : root) {
     const std::string key = keyText(path, entry.first, "sweep file");
+    if (!seen.insert(key).second) failAt(path, entry.first, key, "given twice");
     const YAML::Node& value = entry.second;
     try {
       if (key == "scenario") {
@@ -132,8 +134,12 @@ SweepSpec loadSweep(const std::string& path) {
         spec.shared_overrides = value.as<std::vector<std::string>>();
       } else if (key == "axes") {
         if (!value.IsMap()) failAt(path, value, key, "expected a map of key: [values]");
+        std::set<std::string> axis_keys;
         for (const auto& axis : value) {
           SweepAxis parsed{keyText(path, axis.first, "axes"), {}, {}};
+          if (!axis_keys.insert(parsed.key).second) {
+            failAt(path, axis.first, "axes." + parsed.key, "given twice");
+          }
           const std::string where = "axes." + parsed.key;
           if (axis.second.IsMap() && axis.second.size() > 0) {
             for (const auto& variant : axis.second) {

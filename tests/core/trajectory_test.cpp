@@ -98,6 +98,20 @@ TEST(Tum, OtherErrorsAreClear) {
   EXPECT_NE(errorOf(back).find(back + ":2:"), std::string::npos);
 }
 
+// A quaternion of components near the largest double is still a rotation:
+// (0, 0, 1e308, 1e308) is 90 deg about z, (qw, qz) = (sqrt(1/2), sqrt(1/2))
+// (found by fuzzing: the plain norm overflowed to infinity, the quaternion came
+// back zero; fuzz/regressions/trajectory).
+TEST(Tum, HugeQuaternionComponentsAreARotation) {
+  const std::string huge = tempPath("huge_q.tum");
+  writeText(huge, "0 0 0 0 0 0 1e308 1e308\n");
+  const Trajectory trajectory = readTum(huge);
+  ASSERT_EQ(trajectory.size(), 1u);
+  EXPECT_NEAR(trajectory[0].q_world_body.w(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(trajectory[0].q_world_body.z(), std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(trajectory[0].q_world_body.x(), 0.0);
+}
+
 // Linear position and SLERP attitude between samples; nothing outside the span or over a hole.
 TEST(Interpolate, LinearPositionSlerpAttitude) {
   const Trajectory truth = {poseAt(0, 0, 0, 0, 0), poseAt(1, 10, 0, -4, 90),
