@@ -142,14 +142,11 @@ Trajectory readTum(const std::string& path) {
     pose.t_s = v[0];
     pose.p_ned_m = Eigen::Vector3d(v[1], v[2], v[3]);
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    // Scaled first: a plain norm of components near 1e308 overflows (found by fuzzing).
-    const double scale = q.coeffs().cwiseAbs().maxCoeff();
-    const Eigen::Vector4d unit_scale =
-        scale > 0.0 ? Eigen::Vector4d(q.coeffs() / scale) : Eigen::Vector4d::Zero();
-    if (scale * unit_scale.norm() < 1e-9) {
+    // Eigen's stable norm: a plain one of components near 1e308 overflows (found by fuzzing).
+    if (q.coeffs().stableNorm() < 1e-9) {
       throw TrajectoryError(where + "the quaternion (qx qy qz qw) is zero");
     }
-    pose.q_world_body = Eigen::Quaterniond(unit_scale).normalized();
+    pose.q_world_body = Eigen::Quaterniond(q.coeffs().stableNormalized());
     if (!trajectory.empty() && pose.t_s <= trajectory.back().t_s) {
       throw TrajectoryError(where + "timestamp " + std::string(fields[0]) +
                             " does not increase (timestamps must increase strictly)");
