@@ -43,7 +43,18 @@ void addLaunchCommand(CLI::App& app) {
   command->add_option("--report-period", options->report_period_s, "seconds between reports")
       ->capture_default_str()
       ->check(CLI::Range(0.2, 600.0));
-  command->callback([options] {
+  auto restart = std::make_shared<bool>(false);
+  auto max_restarts = std::make_shared<int>(3);
+  command->add_flag("--restart", *restart,
+                    "start a node that dies again (not nadir-sim or lcm-logger: either dying "
+                    "stops the launch); a VO node's num_resets counts its fresh start");
+  command
+      ->add_option("--max-restarts", *max_restarts,
+                   "with --restart: how many times each node is started again at most")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  command->callback([options, restart, max_restarts] {
+    options->max_restarts = *restart ? *max_restarts : 0;
     std::signal(SIGINT, onLaunchSignal);
     std::signal(SIGTERM, onLaunchSignal);
     const int status = run::launchScenario(*options, std::cout, g_stop_launch);

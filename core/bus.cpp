@@ -124,6 +124,19 @@ std::string describeLosses(const std::map<std::string, ChannelStats>& stats,
   return "nothing lost on " + std::to_string(counted) + (counted == 1 ? " channel" : " channels");
 }
 
+std::string describeMalformed(const std::map<std::string, ChannelStats>& stats) {
+  std::uint64_t total = 0;
+  std::string where;
+  for (const auto& [channel, channel_stats] : stats) {
+    if (channel_stats.decode_errors == 0) continue;
+    total += channel_stats.decode_errors;
+    where +=
+        (where.empty() ? "" : ", ") + channel + " " + std::to_string(channel_stats.decode_errors);
+  }
+  if (total == 0) return {};
+  return "dropped " + std::to_string(total) + " malformed (" + where + ")";
+}
+
 std::string describeArrivals(const std::map<std::string, ChannelStats>& stats,
                              const std::string& ignore) {
   std::string text;
@@ -136,6 +149,9 @@ std::string describeArrivals(const std::map<std::string, ChannelStats>& stats,
       std::snprintf(rate, sizeof(rate), " at %.1f Hz, %lld lost", channel_stats.rate_hz,
                     static_cast<long long>(channel_stats.missing));
       text += rate;
+    }
+    if (channel_stats.decode_errors > 0) {
+      text += ", " + std::to_string(channel_stats.decode_errors) + " malformed";
     }
   }
   return text.empty() ? "nothing" : text;

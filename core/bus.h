@@ -176,8 +176,14 @@ std::optional<int> udpmTtl(const std::string& url);
 std::string describeLosses(const std::map<std::string, ChannelStats>& stats,
                            const std::string& ignore = {});
 
+// Messages dropped because they did not decode as their channel's type (a
+// foreign sender, a wrong fingerprint, truncated or random bytes), for a
+// status line: "dropped 3 malformed (POSE_TRUTH 2, RANGE 1)", or empty if none.
+std::string describeMalformed(const std::map<std::string, ChannelStats>& stats);
+
 // Every channel's messages in one line: "CAMERA_DOWN 1860 at 31.0 Hz, 0 lost;
-// VO_COMMAND 2" (no rate: irregular, or too few to learn one).
+// VO_COMMAND 2" (no rate: irregular, or too few to learn one), with ", 3
+// malformed" where some did not decode.
 std::string describeArrivals(const std::map<std::string, ChannelStats>& stats,
                              const std::string& ignore = {});
 

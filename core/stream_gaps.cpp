@@ -50,6 +50,23 @@ void StreamGaps::count(std::int64_t utime) {
     last_utime_ = utime;
     return;
   }
+  if (ahead_utime_) {
+    // After a jump forward: a stream that goes on after it lost what the jump
+    // spans; one that goes on from before it makes the jump a time from elsewhere.
+    const std::int64_t ahead = *ahead_utime_;
+    ahead_utime_.reset();
+    if (utime > ahead) {
+      const auto lost =
+          static_cast<std::int64_t>(std::llround(
+              (static_cast<double>(ahead) - static_cast<double>(*last_utime_)) / period_us_)) -
+          1;
+      missing_ += lost;
+      ++gaps_;
+      last_utime_ = ahead;
+    } else {
+      ++out_of_order_;
+    }
+  }
   // In double: the times of a foreign message are any 64 bits.
   const double step_us = static_cast<double>(utime) - static_cast<double>(*last_utime_);
   if (step_us <= 0.0) {
@@ -59,12 +76,9 @@ void StreamGaps::count(std::int64_t utime) {
   }
   if (step_us > kMaxStep_us) {
     ++out_of_order_;
-  } else if (period_us_ > 0.0) {
-    const auto lost = static_cast<std::int64_t>(std::llround(step_us / period_us_)) - 1;
-    if (lost > 0) {
-      missing_ += lost;
-      ++gaps_;
-    }
+  } else if (period_us_ > 0.0 && std::llround(step_us / period_us_) > 1) {
+    ahead_utime_ = utime;
+    return;
   }
   last_utime_ = utime;
 }

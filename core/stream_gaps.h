@@ -4,6 +4,9 @@
 // The period is given (the rate the sender should keep) or learnt from the
 // first intervals; a stream whose first intervals are not multiples of one
 // period (commands, heartbeats of several nodes) is irregular and not counted.
+// A jump forward is counted once the stream goes on after it: a message
+// stamped ahead of its stream that the stream then does not follow (a foreign
+// or corrupt message) is out of order, never a loss.
 
 #include <cstdint>
 #include <optional>
@@ -29,8 +32,9 @@ class StreamGaps {
   // Places where one or more were lost.
   std::int64_t gaps() const { return gaps_; }
   // Messages at or before the time of the one before (repeats, a log looped or
-  // seeked), or more than an hour after it (a time from elsewhere: a foreign or
-  // corrupt message); neither counts as a loss.
+  // seeked), more than an hour after it, or ahead of it where the stream then
+  // went on from before (a time from elsewhere: a foreign or corrupt message);
+  // none counts as a loss.
   std::int64_t outOfOrder() const { return out_of_order_; }
   // The period counted with: given or learnt; 0 while not known or when irregular.
   double rateHz() const;
@@ -46,6 +50,7 @@ class StreamGaps {
   bool irregular_ = false;
   std::vector<std::int64_t> first_times_;  // until the period is known
   std::optional<std::int64_t> last_utime_;
+  std::optional<std::int64_t> ahead_utime_;  // a jump forward, until the stream goes on
   std::int64_t received_ = 0;
   std::int64_t missing_ = 0;
   std::int64_t gaps_ = 0;

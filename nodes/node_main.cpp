@@ -69,12 +69,15 @@ class Heartbeat {
     last_ = std::chrono::steady_clock::now();
     std::map<std::string, std::int64_t> sent = bus_.sent();
     sent.erase(channel_);  // its own heartbeats are not the node's output
+    const auto stats = bus_.stats();
+    std::string summary = running.summary() + "; " + core::describeLosses(stats, channel_);
+    if (const std::string malformed = core::describeMalformed(stats); !malformed.empty()) {
+      summary += "; " + malformed;
+    }
     msg::publish(
         bus_, channel_,
         msg::Heartbeat{core::wallClockUtime(), node_, static_cast<std::int32_t>(::getpid()),
-                       sequence_++, done,
-                       running.summary() + "; " + core::describeLosses(bus_.stats(), channel_),
-                       std::move(sent)});
+                       sequence_++, done, std::move(summary), std::move(sent)});
   }
 
   core::Bus& bus_;
@@ -94,6 +97,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
   std::string config_path;
   std::vector<std::string> overrides;
   bool list = false;
+  int resets_before = 0;
   auto* scenario_option =
       app.add_option("scenario,--scenario", scenario_name, "built-in scenario name or YAML file")
           ->capture_default_str();
@@ -105,6 +109,10 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
                  "override a parameter: key=value (repeatable; keys of the scenario, or of "
                  "the --config file)");
   app.add_flag("--list", list, "list the built-in scenarios and exit");
+  app.add_option("--resets-before", resets_before,
+                 "this process replaces one that died: a VO node's num_resets goes on from "
+                 "here (nadir launch --restart sets it)")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   if (list) {
     listScenarios();
@@ -132,6 +140,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
     auto bus = core::openBus(params.bus);
     for (const auto& [channel, rate_hz] : expected_rates_hz) bus->expectRate(channel, rate_hz);
     const std::unique_ptr<Node> node = node_entry.start(*bus, params.node);
+    if (resets_before > 0) node->continueResetCount(resets_before);
     if (const std::string about = node->describe(); !about.empty()) std::cout << about << "\n";
     std::cout << "bus: " << bus->url() << std::endl;
     std::signal(SIGINT, onSignal);

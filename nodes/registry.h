@@ -38,6 +38,10 @@ class Node {
   virtual std::string summary() const = 0;
   // What it works on (its world, its renderer), printed once when it starts.
   virtual std::string describe() const { return {}; }
+  // This process replaces one that died (nadir launch --restart): a VO node
+  // counts its fresh start as a reset, so its num_resets goes on from
+  // resets_before and a reader sees its estimate restart. Others ignore it.
+  virtual void continueResetCount(int resets_before) { (void)resets_before; }
 };
 
 // A stream a node publishes, for launch's health report and sweeps' logs.

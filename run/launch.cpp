@@ -47,10 +47,18 @@ std::string programPath(const std::string& bin_dir, const std::string& name) {
 struct ChannelHealth {
   std::int64_t total = 0;
   std::int64_t window = 0;
+  Clock::time_point last_arrival;
   // Rate the scenario should produce, Hz of sim time; 0 when not known.
   double expected_hz = 0.0;
   int vo_status = -1;
+  bool quiet = false;  // reported quiet, nothing since
 };
+
+std::string formatSeconds(Clock::duration duration) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f s", std::chrono::duration<double>(duration).count());
+  return text;
+}
 
 // Messages lost on the way to this process, from their times (the bus's count).
 std::int64_t missingOn(const std::map<std::string, core::ChannelStats>& stats,
@@ -92,12 +100,32 @@ class RecordingCounter {
 };
 
 // What a node's heartbeats say: its summary, what it has sent, whether that
-// changed since the heartbeat before (it is still at work) and whether it is done.
+// changed since the heartbeat before (it is still at work) and whether it is
+// done; when the last came, and what processes of it that died had sent.
 struct NodeReport {
   std::string summary;
   std::map<std::string, std::int64_t> sent;
   bool working = true;
   bool done = false;
+  std::int32_t pid = 0;
+  std::map<std::string, std::int64_t> sent_before;  // by earlier processes
+  Clock::time_point last_beat;
+  bool silent = false;  // reported silent, not heard since
+
+  std::int64_t sentOn(const std::string& channel) const {
+    const auto now = sent.find(channel);
+    const auto before = sent_before.find(channel);
+    return (now == sent.end() ? 0 : now->second) +
+           (before == sent_before.end() ? 0 : before->second);
+  }
+  // A heartbeat from another process of this node: what the last sent stays counted.
+  void newProcess(std::int32_t new_pid) {
+    if (pid != 0 && new_pid != pid) {
+      for (const auto& [channel, count] : sent) sent_before[channel] += count;
+      sent.clear();
+    }
+    pid = new_pid;
+  }
 };
 
 // Channels whose messages the recording holds fewer of than the nodes sent.
@@ -105,7 +133,11 @@ std::map<std::string, std::pair<std::int64_t, std::int64_t>> missingFromRecordin
     const std::map<std::string, NodeReport>& reports, const RecordingCounter& recording) {
   std::map<std::string, std::pair<std::int64_t, std::int64_t>> missing;  // sent, recorded
   for (const auto& [node, report] : reports) {
-    for (const auto& [channel, sent] : report.sent) {
+    std::set<std::string> channels;
+    for (const auto& [channel, count] : report.sent) channels.insert(channel);
+    for (const auto& [channel, count] : report.sent_before) channels.insert(channel);
+    for (const std::string& channel : channels) {
+      const std::int64_t sent = report.sentOn(channel);
       if (recording.count(channel) < sent) missing[channel] = {sent, recording.count(channel)};
     }
   }
@@ -116,6 +148,9 @@ struct LaunchedNode {
   const nodes::Entry* entry = nullptr;
   std::unique_ptr<ChildProcess> process;
   std::string host;
+  std::vector<std::string> argv;                    // the program's, before the host's prefix
+  std::vector<std::string> channels;                // what it publishes
+  std::vector<std::unique_ptr<ChildProcess>> died;  // its processes that died, restarted
 };
 
 // A simulator on the bus that is not this launch's, seen before this one starts.
@@ -303,11 +338,18 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       argv.push_back(assignment);
     }
     const LaunchHost& host = hosts.hostOf(entry->info().name);
+    std::vector<std::string> published;
+    for (const nodes::Stream& stream : entry->streams(entry->fromScenario(scenario))) {
+      published.push_back(stream.channel);
+    }
     launched.push_back(
         {entry.get(),
          std::make_unique<ChildProcess>(entry->info().program, hosts.command(host, argv, bin_dir),
                                         nodeLog(entry->info().name)),
-         host.name});
+         host.name,
+         argv,
+         std::move(published),
+         {}});
   }
   for (const auto& [channel, rate_hz] : nodes::expectedRates(scenario)) {
     channels[channel].expected_hz = rate_hz;
@@ -331,8 +373,15 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   }
   const auto bus_opened = Clock::now();
   std::map<std::string, NodeReport> heartbeats;  // by node name
+  std::map<std::string, int> resets_by_source;   // the last num_resets of each VO source
   ForeignSimulator foreign;
   bool simulator_started = false;
+  const auto programOf = [&](const std::string& node_name) {
+    for (const LaunchedNode& node : launched) {
+      if (node.entry->info().name == node_name) return node.entry->info().program;
+    }
+    return node_name;
+  };
   const std::string simulator_name = [&] {
     for (const LaunchedNode& node : launched) {
       if (isSimulator(node)) return node.entry->info().name;
@@ -352,22 +401,40 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
           return;
         }
         NodeReport& report = heartbeats[beat.node];
+        report.newProcess(beat.pid);
         report.working = beat.sent != report.sent;
         report.sent = beat.sent;
         report.summary = beat.summary;
         report.done = report.done || beat.done;
+        const auto now = Clock::now();
+        if (report.silent) {
+          out << "launch: " << programOf(beat.node) << " heard again after "
+              << formatSeconds(now - report.last_beat) << " of silence\n";
+          report.silent = false;
+        }
+        report.last_beat = now;
       } catch (const std::exception&) {
+        bus->countDecodeError(raw.channel);
       }
       return;
     }
     ChannelHealth& health = channels[std::string(raw.channel)];
     ++health.total;
     ++health.window;
+    const auto now = Clock::now();
+    if (health.quiet) {
+      out << "launch: " << raw.channel << " flowing again after "
+          << formatSeconds(now - health.last_arrival) << "\n";
+      health.quiet = false;
+    }
+    health.last_arrival = now;
     if (msg::isType<msg::VoEstimate>(raw.data, raw.size)) {
       try {
-        health.vo_status =
-            static_cast<int>(msg::decode<msg::VoEstimate>(raw.data, raw.size).status);
+        const msg::VoEstimate estimate = msg::decode<msg::VoEstimate>(raw.data, raw.size);
+        health.vo_status = static_cast<int>(estimate.status);
+        resets_by_source[estimate.source] = estimate.num_resets;
       } catch (const std::exception&) {
+        bus->countDecodeError(raw.channel);
       }
     }
   });
@@ -404,10 +471,80 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   const auto stopAll = [&] {
     for (auto it = processes.rbegin(); it != processes.rend(); ++it) (*it)->stop(5.0);
   };
-  const auto failed = [&](const ChildProcess& node) {
+  const auto reportDeath = [&](const ChildProcess& node) {
     out << "launch: " << node.name() << " died (" << node.describeExit() << "); see "
         << node.logPath() << "\n";
+  };
+  const auto failed = [&](const ChildProcess& node) {
+    reportDeath(node);
     result = 1;
+  };
+  // A node started again in place of one that died; a VO node's num_resets
+  // goes on from the last its estimates carried, plus its fresh start.
+  const auto restart = [&](LaunchedNode& node) {
+    const std::string& name = node.entry->info().name;
+    const int number = static_cast<int>(node.died.size()) + 1;
+    std::vector<std::string> argv = node.argv;
+    const auto resets = resets_by_source.find(name);
+    if (resets != resets_by_source.end()) {
+      argv.push_back("--resets-before");
+      argv.push_back(std::to_string(resets->second + 1));
+    }
+    auto process = std::make_unique<ChildProcess>(
+        node.process->name(), hosts.command(hosts.hostOf(name), argv, bin_dir),
+        nodeLog(name + "-restart" + std::to_string(number)));
+    process->start();
+    out << "launch: restarted " << process->name() << " (restart " << number << " of at most "
+        << options.max_restarts << ")";
+    if (resets != resets_by_source.end()) {
+      out << "; its num_resets goes on from " << resets->second + 1;
+    }
+    out << "; see " << process->logPath() << "\n";
+    std::replace(processes.begin(), processes.end(), node.process.get(), process.get());
+    node.died.push_back(std::move(node.process));
+    node.process = std::move(process);
+    // Not silent while it starts: watched again from its first heartbeat.
+    NodeReport& report = heartbeats[name];
+    report.last_beat = {};
+    report.silent = false;
+  };
+  // A node whose heartbeat is late, a channel with a rate (the scenario's, or
+  // as learnt) that has stopped: said at once, and again when heard.
+  const auto reportSilence = [&] {
+    const auto now = Clock::now();
+    const auto stats = bus->stats();
+    const auto late = std::chrono::duration<double>(kSilentAfter_s);
+    for (const LaunchedNode& node : launched) {
+      const auto report = heartbeats.find(node.entry->info().name);
+      if (report == heartbeats.end() || report->second.silent ||
+          report->second.last_beat == Clock::time_point{} ||
+          now - report->second.last_beat < late) {
+        continue;
+      }
+      report->second.silent = true;
+      out << "launch: " << node.entry->info().program << " silent: no heartbeat for "
+          << formatSeconds(now - report->second.last_beat) << "\n";
+    }
+    for (auto& [name, health] : channels) {
+      if (health.quiet || health.total == 0) continue;
+      const auto learnt = stats.find(name);
+      const double rate_hz = health.expected_hz > 0.0 ? health.expected_hz
+                             : learnt != stats.end()  ? learnt->second.rate_hz
+                                                      : 0.0;
+      if (rate_hz <= 0.0) continue;
+      const auto expected_gap = std::chrono::duration<double>(
+          std::max(kSilentAfter_s, 3.0 / (rate_hz * scenario.time.speed)));
+      if (now - health.last_arrival < expected_gap) continue;
+      health.quiet = true;
+      std::string from;
+      for (const LaunchedNode& node : launched) {
+        for (const std::string& channel : node.channels) {
+          if (channel == name) from = " (" + node.entry->info().program + ")";
+        }
+      }
+      out << "launch: " << name << from << " quiet for " << formatSeconds(now - health.last_arrival)
+          << "\n";
+    }
   };
   try {
     logger.start();
@@ -482,17 +619,27 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         stopAll();
         break;
       }
-      bool node_died = false;
-      for (ChildProcess* node : processes) {
-        if (node != simulator && !node->running()) {
-          failed(*node);
-          node_died = true;
+      bool must_stop = false;
+      if (!logger.running()) {
+        failed(logger);
+        out << "launch: the recording ends there; stopping every node\n";
+        must_stop = true;
+      }
+      for (LaunchedNode& node : launched) {
+        if (isSimulator(node) || node.process->running()) continue;
+        if (static_cast<int>(node.died.size()) < options.max_restarts && !must_stop) {
+          reportDeath(*node.process);
+          restart(node);
+        } else {
+          failed(*node.process);
+          must_stop = true;
         }
       }
-      if (node_died) {
+      if (must_stop) {
         stopAll();
         break;
       }
+      reportSilence();
       const auto now = Clock::now();
       const double window_s = std::chrono::duration<double>(now - last_report).count();
       if (window_s >= options.report_period_s) {
@@ -508,7 +655,13 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   }
   out << "launch: nodes\n";
   std::map<const ChildProcess*, std::string> host_of = {{&logger, logger_host.name}};
-  for (const LaunchedNode& node : launched) host_of[node.process.get()] = node.host;
+  for (const LaunchedNode& node : launched) {
+    host_of[node.process.get()] = node.host;
+    for (const auto& dead : node.died) {
+      out << "  " << dead->name() << (several_hosts ? " on " + node.host : "") << ": "
+          << dead->describeExit() << ", restarted; see " << dead->logPath() << "\n";
+    }
+  }
   for (const ChildProcess* node : processes) {
     const bool clean =
         node->exitStatus() == 0 || (node->stoppedByUs() && node->exitStatus() != 128 + SIGKILL);
@@ -517,12 +670,21 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         << (clean ? "" : "  <- problem") << "\n";
     if (!clean && result == 0) result = 1;
   }
+  out << "launch: what each node said last\n";
+  for (const LaunchedNode& node : launched) {
+    const auto report = heartbeats.find(node.entry->info().name);
+    out << "  " << node.entry->info().program << ": "
+        << (report == heartbeats.end() ? "no heartbeat" : report->second.summary) << "\n";
+  }
   out << "launch: messages received\n";
   const auto final_stats = bus->stats();
   for (const auto& [name, health] : channels) {
     out << "  " << name << ": " << health.total;
     if (health.expected_hz > 0.0) out << " (" << missingOn(final_stats, name) << " missing)";
     out << "\n";
+  }
+  if (const std::string malformed = core::describeMalformed(final_stats); !malformed.empty()) {
+    out << "launch: " << malformed << "\n";
   }
   if (!recordingHere()) {
     out << "launch: the recording is on " << logger_host.describe() << " at "

@@ -4,7 +4,9 @@
 // health (message rates against what the scenario expects, VO status, exit
 // statuses) is printed while they run, and all are stopped cleanly when the
 // scenario ends or on request. A node that dies is reported with its exit
-// status and stops the launch.
+// status and stops the launch, or is restarted (max_restarts); a node that
+// falls silent (stopped, hung) is reported. docs/reliability.md says what
+// survives which fault.
 
 #include <atomic>
 #include <ostream>
@@ -27,7 +29,15 @@ struct LaunchOptions {
   std::string hosts_file;
   // How long the bus may take to join every host before the flight is refused.
   double bus_check_timeout_s = 20.0;
+  // A node that dies is started again, up to this many times each; 0: a dead
+  // node stops the launch. Never the simulator (the flight is its) nor
+  // lcm-logger (the recording is its): either dying stops the launch.
+  int max_restarts = 0;
 };
+
+// A node whose heartbeat is this late (they come once a second) is reported
+// silent, with its channels, at once.
+inline constexpr double kSilentAfter_s = 1.5;
 
 // Runs until the scenario ends, a node dies or stop becomes true. Returns the
 // exit status for the launch: 0 when the scenario ended and every node exited

@@ -3,7 +3,10 @@
 # (docs/reliability.md), in the fuzz targets' build directory: Clang, -O1, the
 # Qt viewers and the whole-flight tests that need them (tests/run, tests/gui)
 # not built, and the tests named below left out.
-#   scripts/sanitize.sh [ctest arguments...]
+#   scripts/sanitize.sh [ctest arguments...]            the whole suite
+#   scripts/sanitize.sh --readers [ctest arguments...]  only the readers of outside
+#       bytes and their tests (tests/core, lcmtypes, terrain, logs, logs/eval and
+#       the fuzz inputs' replays): what .ci/run builds
 set -euo pipefail
 
 source "$(dirname "${BASH_SOURCE[0]}")/fuzz_build.sh"
@@ -21,17 +24,24 @@ excluded=(
   'VirtualCalibration\.FisheyeModelAt640x480$'
 )
 
-configure_fuzz_build || exit 1
-cmake --build "$build_dir" --parallel "$jobs" >&2 || die "the sanitizer build failed (see above)"
+selection=()
+targets=()
+if [ "${1:-}" = --readers ]; then
+  shift
+  label_regex="^($(IFS='|'; echo "${readers_test_labels[*]}"))\$"
+  selection=(-L "$label_regex")
+  # their fuzz targets need every node (scripts/fuzz_build.sh)
+  excluded+=('FuzzReplay\.(scenario|sweep)$')
+  targets=(--target core_test hosts_test lcm_probe lcmtypes_test codec_test terrain_readers_test
+    procedural_world_test tiles_test course_test logs_test eval_test
+    "${readers_fuzz_targets[@]/#/nadir_fuzz_replay_}")
+fi
 
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}"
-export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-# Mesa unloads its driver when a program ends its EGL display; what the
-# driver's globals still held then looks leaked to LeakSanitizer. Kept loaded,
-# the driver's globals are seen and nothing is reported.
-for driver in /usr/lib/*/dri/swrast_dri.so; do
-  [ -f "$driver" ] && export LD_PRELOAD="$driver${LD_PRELOAD:+:$LD_PRELOAD}"
-  break
-done
+configure_fuzz_build || exit 1
+cmake --build "$build_dir" --parallel "$jobs" "${targets[@]}" >&2 ||
+  die "the sanitizer build failed (see above)"
+
+export_sanitizer_options
 exclude_regex="$(IFS='|'; echo "${excluded[*]}")"
-exec ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -E "$exclude_regex" "$@"
+exec ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -E "$exclude_regex" \
+  "${selection[@]}" "$@"

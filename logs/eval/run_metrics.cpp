@@ -76,6 +76,7 @@ Json sourceJson(const SourceMetrics& m) {
   j["end_point_m"] = number(m.end_point_m);
   j["end_point_pct"] = number(m.end_point_pct);
   j["rate_hz"] = number(m.rate_hz);
+  j["longest_gap_s"] = number(m.longest_gap_s);
   j["first_tracking_s"] = number(m.first_tracking_s);
   j["estimates"] = m.estimates;
   j["estimates_tracking"] = m.estimates_tracking;
@@ -189,6 +190,12 @@ class JsonReader {
     if (!value.is_number_unsigned()) fail(where + "." + key, "is not a count");
     return value.get<std::size_t>();
   }
+  // Absent (older files) or null: NaN.
+  double optionalNumber(const Json& object, const std::string& key,
+                        const std::string& where) const {
+    if (!object.is_object()) fail(where, "is not an object");
+    return object.contains(key) ? number(object, key, where) : kNaN;
+  }
   // Absent (older files) or null: none.
   std::optional<std::size_t> optionalCount(const Json& object, const std::string& key,
                                            const std::string& where) const {
@@ -243,6 +250,7 @@ SourceMetrics sourceFromJson(const JsonReader& r, const Json& j, const std::stri
   m.end_point_m = r.number(j, "end_point_m", where);
   m.end_point_pct = r.number(j, "end_point_pct", where);
   m.rate_hz = r.number(j, "rate_hz", where);
+  m.longest_gap_s = r.optionalNumber(j, "longest_gap_s", where);
   m.first_tracking_s = r.number(j, "first_tracking_s", where);
   m.estimates = r.count(j, "estimates", where);
   m.estimates_tracking = r.count(j, "estimates_tracking", where);
@@ -416,6 +424,10 @@ SourceMetrics evaluateSource(const core::Trajectory& truth,
                                      static_cast<std::size_t>(std::max(e.resets, 0)));
   if (sorted.size() >= 2 && sorted.back().t_s > sorted.front().t_s) {
     m.rate_hz = static_cast<double>(sorted.size() - 1) / (sorted.back().t_s - sorted.front().t_s);
+  }
+  for (std::size_t k = 1; k < sorted.size(); ++k) {
+    const double gap_s = sorted[k].t_s - sorted[k - 1].t_s;
+    if (!(gap_s <= m.longest_gap_s)) m.longest_gap_s = gap_s;
   }
   m.tracked_pct = 100.0 * trackedTime(sorted, t0, t1, options.tracked_hold_periods) / (t1 - t0);
 

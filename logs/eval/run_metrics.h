@@ -32,6 +32,9 @@ struct SourceMetrics {
   std::optional<std::size_t> resets;
   double first_tracking_s = kNaN;  // first TRACKING stamp minus the truth start, s
   double rate_hz = kNaN;
+  // The longest time between two estimates, s (a node that died or stalled);
+  // NaN with fewer than two, or from a metrics.json written before it was.
+  double longest_gap_s = kNaN;
   double tracked_pct = 0;
   double position_rmse_m = kNaN;
   double rotation_rmse_deg = kNaN;

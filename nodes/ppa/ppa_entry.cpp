@@ -33,6 +33,7 @@ class PpaLiveNode final : public Node {
   PpaLiveNode(core::Bus& bus, const PpaProcessParams& params)
       : node_(bus, params.node, targetsOf(params.known_targets_ne_m)) {}
 
+  void continueResetCount(int resets_before) override { node_.continueResetCount(resets_before); }
   std::string summary() const override {
     std::ostringstream out;
     out << node_.frames() << " frames, " << static_cast<long long>(node_.meanInstructionsPerFrame())

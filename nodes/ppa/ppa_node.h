@@ -47,6 +47,8 @@ class PpaNode {
   // Resets applied (vo_estimate_t's num_resets).
   int resets() const { return resets_; }
   const nodes::VoCommandListener& commands() const { return commands_; }
+  // num_resets starts here (a process restarted after one that died).
+  void continueResetCount(int resets_before) { resets_ = resets_before; }
 
  private:
   void onImage(const msg::Image& image);

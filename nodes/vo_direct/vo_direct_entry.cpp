@@ -13,6 +13,7 @@ class VoDirectLiveNode final : public Node {
   VoDirectLiveNode(core::Bus& bus, const vo::VoDirectNodeParams& params) : node_(bus, params) {}
 
   std::string summary() const override { return voNodeSummary(node_); }
+  void continueResetCount(int resets_before) override { node_.continueResetCount(resets_before); }
 
  private:
   vo::VoDirectNode node_;

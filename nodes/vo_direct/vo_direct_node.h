@@ -57,6 +57,8 @@ class VoDirectNode {
   double processingSeconds() const { return processing_s_; }
   const DirectVo& vo() const { return vo_; }
   const nodes::VoCommandListener& commands() const { return commands_; }
+  // num_resets starts here (a process restarted after one that died).
+  void continueResetCount(int resets_before) { resets_before_ = resets_before; }
 
  private:
   void onImage(const msg::Image& image);
@@ -70,6 +72,7 @@ class VoDirectNode {
   // Reset requests taken since the last frame, applied before the next one
   // (handlers and frames both run on the bus's dispatch thread).
   std::vector<nodes::VoResetRequest> pending_resets_;
+  int resets_before_ = 0;
   nodes::VoCommandListener commands_;
   bool started_ = false;
   std::uint64_t frames_ = 0;

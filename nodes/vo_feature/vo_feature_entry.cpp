@@ -13,6 +13,7 @@ class VoFeatureLiveNode final : public Node {
   VoFeatureLiveNode(core::Bus& bus, const vo::VoFeatureNodeParams& params) : node_(bus, params) {}
 
   std::string summary() const override { return voNodeSummary(node_); }
+  void continueResetCount(int resets_before) override { node_.continueResetCount(resets_before); }
 
  private:
   vo::VoFeatureNode node_;

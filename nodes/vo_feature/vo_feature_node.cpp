@@ -91,7 +91,7 @@ void VoFeatureNode::onImage(const msg::Image& image) {
   estimate.p_ned_m = out.T_world_body.translation();
   estimate.q_world_body = Eigen::Quaterniond(out.T_world_body.rotation());
   estimate.num_features = out.tracked_points;
-  estimate.num_resets = out.resets;
+  estimate.num_resets = resets_before_ + out.resets;
   estimate.processing_time_s = params_.wall_clock_timing ? elapsed_s : 0.0;
   msg::publish(bus_, params_.pose_channel, estimate);
   if (params_.debug_every_frames > 0 &&

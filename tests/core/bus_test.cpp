@@ -95,6 +95,11 @@ TEST(Bus, UndecodableMessageIsDroppedAndCounted) {
   ASSERT_EQ(stats.count("POSE_TRUTH"), 1u);
   EXPECT_EQ(stats.at("POSE_TRUTH").messages, 3u);
   EXPECT_EQ(stats.at("POSE_TRUTH").decode_errors, 2u);
+  // What a node's heartbeat and last line say of them.
+  EXPECT_EQ(describeMalformed(stats), "dropped 2 malformed (POSE_TRUTH 2)");
+  EXPECT_NE(describeArrivals(stats).find("POSE_TRUTH 3, 2 malformed"), std::string::npos)
+      << describeArrivals(stats);
+  EXPECT_EQ(describeMalformed({}), "");
 }
 
 // An exception thrown in a handler comes out of handle(), and the bus keeps working.

@@ -81,9 +81,11 @@ TEST(StreamGaps, ALoopIsANewStartAndALateMessageIsOutOfOrder) {
   }
   EXPECT_EQ(gaps.missing(), 0);
   EXPECT_EQ(gaps.outOfOrder(), 1);
-  // 0, 10, 30, 20, 40 ms: 20 comes late; one interval of two periods (10 -> 30).
+  // 0, 10, 30, 20, 40, 50 ms: 30 comes before 20, which the stream goes on
+  // from: 30 is out of order, and the interval 20 -> 40 spans it (one lost: a
+  // message out of order counts, once, never hidden).
   StreamGaps late(100.0);
-  for (const std::int64_t t : {0, 10000, 30000, 20000, 40000}) late.add(t);
+  for (const std::int64_t t : {0, 10000, 30000, 20000, 40000, 50000}) late.add(t);
   EXPECT_EQ(late.outOfOrder(), 1);
   EXPECT_EQ(late.missing(), 1);
 }
@@ -109,6 +111,23 @@ TEST(StreamGaps, ATimeFromElsewhereIsNoLoss) {
   StreamGaps learnt;
   for (int k = 0; k <= StreamGaps::kLearnIntervals; ++k) learnt.add(k == 8 ? kMax : k * 10000);
   EXPECT_NEAR(learnt.rateHz(), 100.0, 1e-9);
+}
+
+// At 100 Hz, a message stamped 60 s ahead between 40 and 50 ms (another
+// sender's, or a corrupt one) is out of order, not 5999 lost: the stream went
+// on from before it. A real gap (60 and 70 ms lost) counts 2 once the stream
+// goes on after it, and is not counted while only its first message has come.
+TEST(StreamGaps, AJumpAheadCountsOnlyWhenTheStreamGoesOnAfterIt) {
+  StreamGaps gaps(100.0);
+  for (const std::int64_t t : {0L, 10000L, 20000L, 30000L, 40000L, 60'000'000L, 50000L, 80000L}) {
+    gaps.add(t);
+  }
+  EXPECT_EQ(gaps.missing(), 0);  // 80 ms waits for the stream to go on
+  EXPECT_EQ(gaps.outOfOrder(), 1);
+  gaps.add(90000);
+  EXPECT_EQ(gaps.missing(), 2);
+  EXPECT_EQ(gaps.gaps(), 1);
+  EXPECT_EQ(gaps.outOfOrder(), 1);
 }
 
 // The bus counts gaps per channel from every message it receives, at the

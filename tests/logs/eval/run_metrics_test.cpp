@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -67,6 +68,18 @@ TEST(EvalRunMetrics, GapInTrackingGivesHandTrackedPct) {
   EXPECT_NEAR(m.truth_track_length_m, 78.0, 1e-9);
   EXPECT_NEAR(m.rpe_translation_m.rmse, 0.0, 1e-9);
   EXPECT_EQ(m.rpe_translation_m.count, 29u + 49u);  // pairs never straddle the gap
+  EXPECT_NEAR(m.longest_gap_s, 0.1, 1e-9);          // LOST estimates still came every 0.1 s
+}
+
+// A node that died at 3.0 s and published again from 5.2 s: its estimates stop
+// for 2.2 s (the last at 2.9 s, the next at 5.2 s), and that is the longest gap.
+TEST(EvalRunMetrics, ANodeThatDiedLeavesItsLongestGap) {
+  std::vector<SourceEstimate> estimates =
+      estimatesAt10Hz(0, [](int) { return SourceEstimate::kTracking; });
+  std::erase_if(estimates, [](const SourceEstimate& e) { return e.t_s > 2.95 && e.t_s < 5.15; });
+  const SourceMetrics m = evaluateSource(straightTruth(), estimates, EvalOptions{});
+  EXPECT_NEAR(m.longest_gap_s, 5.2 - 2.9, 1e-9);
+  EXPECT_EQ(m.tracking_segments, 1u);  // the statuses alone do not show it
 }
 
 // A node's num_resets is a running count: the source's resets are the largest
@@ -255,6 +268,7 @@ TEST(EvalMetricsJson, RoundTrip) {
     expectSame(r.end_point_m, w.end_point_m);
     expectSame(r.end_point_pct, w.end_point_pct);
     expectSame(r.rate_hz, w.rate_hz);
+    expectSame(r.longest_gap_s, w.longest_gap_s);
     expectSame(r.first_tracking_s, w.first_tracking_s);
     expectSame(r.alignment_scale, w.alignment_scale);
     EXPECT_EQ(r.alignment, w.alignment);
