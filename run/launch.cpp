@@ -37,6 +37,9 @@ using Clock = std::chrono::steady_clock;
 // How long the end of a launch waits for the nodes to finish their work and for
 // the recording to hold it, at most.
 constexpr auto kSettleLimit = std::chrono::seconds(120);
+// Less free space than this where the recording is, when the logger dies: the
+// disk is full (lcm-logger stops at its first failed write).
+constexpr std::uintmax_t kFullDisk_bytes = 1 << 20;
 
 std::string programPath(const std::string& bin_dir, const std::string& name) {
   const fs::path path = fs::path(bin_dir) / name;
@@ -472,8 +475,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
     for (auto it = processes.rbegin(); it != processes.rend(); ++it) (*it)->stop(5.0);
   };
   const auto reportDeath = [&](const ChildProcess& node) {
-    out << "launch: " << node.name() << " died (" << node.describeExit() << "); see "
-        << node.logPath() << "\n";
+    out << "launch: " << node.name() << " died (" << node.describeExit() << ")";
+    if (const std::string words = node.lastWords(); !words.empty()) {
+      out << ", its last words: \"" << words << "\"";
+    }
+    out << "; see " << node.logPath() << "\n";
   };
   const auto failed = [&](const ChildProcess& node) {
     reportDeath(node);
@@ -622,6 +628,12 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
       bool must_stop = false;
       if (!logger.running()) {
         failed(logger);
+        std::error_code error;
+        const fs::space_info space = fs::space(out_path, error);
+        if (!error && space.available < kFullDisk_bytes) {
+          out << "launch: the disk holding " << out_dir << " is full (" << space.available
+              << " bytes free)\n";
+        }
         out << "launch: the recording ends there; stopping every node\n";
         must_stop = true;
       }

@@ -12,6 +12,8 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <thread>
 
@@ -117,6 +119,22 @@ void ChildProcess::stop(double grace_s) {
 std::string ChildProcess::describeExit() const {
   if (exit_status_ >= 128) return "killed by signal " + std::to_string(exit_status_ - 128);
   return "exit status " + std::to_string(exit_status_);
+}
+
+std::string ChildProcess::lastWords() const {
+  std::ifstream log(log_path_, std::ios::binary | std::ios::ate);
+  if (!log) return {};
+  constexpr std::streamoff kTail = 4096;
+  const std::streamoff size = log.tellg();
+  log.seekg(std::max<std::streamoff>(0, size - kTail));
+  std::string tail((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r' || tail.back() == ' ')) {
+    tail.pop_back();
+  }
+  const std::size_t start = tail.find_last_of('\n');
+  std::string line = start == std::string::npos ? tail : tail.substr(start + 1);
+  if (line.size() > 300) line = line.substr(0, 300) + "...";
+  return line;
 }
 
 std::vector<std::string> splitWords(const std::string& text) {

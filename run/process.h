@@ -52,6 +52,8 @@ class ChildProcess {
   bool stoppedByUs() const { return stopped_by_us_; }
   // "exit status 3" or "killed by signal 9".
   std::string describeExit() const;
+  // The last line the program wrote (its log's), at most 300 bytes; empty if none.
+  std::string lastWords() const;
 
  private:
   std::string name_;

@@ -6,10 +6,11 @@ build_dir="${NADIR_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 jobs="${NADIR_JOBS:-$(nproc)}"
 
 # What scripts/sanitize.sh --readers builds and tests, and .ci/run fuzzes: the
-# code that reads bytes from outside (logs, messages, terrain files, flight
-# logs), which needs none of the nodes. The scenario and sweep targets need them
-# all (a build as long as the whole suite's).
-readers_test_labels=(core lcmtypes terrain logs logs/eval fuzz)
+# code that reads bytes from outside (logs, messages, parameters, terrain files,
+# flight logs, metrics files) and its test programs, which need none of the
+# nodes. The scenario and sweep targets need them all (a build as long as the
+# whole suite's).
+readers_test_programs=(core_test lcmtypes_test codec_test terrain_readers_test logs_test eval_test)
 readers_fuzz_targets=(lcm_log messages trajectory dem imagery flight_log)
 
 configure_fuzz_build() {

@@ -5,8 +5,8 @@
 # not built, and the tests named below left out.
 #   scripts/sanitize.sh [ctest arguments...]            the whole suite
 #   scripts/sanitize.sh --readers [ctest arguments...]  only the readers of outside
-#       bytes and their tests (tests/core, lcmtypes, terrain, logs, logs/eval and
-#       the fuzz inputs' replays): what .ci/run builds
+#       bytes and their tests (scripts/fuzz_build.sh lists the programs) and the
+#       fuzz inputs' replays: what .ci/run builds
 set -euo pipefail
 
 source "$(dirname "${BASH_SOURCE[0]}")/fuzz_build.sh"
@@ -28,13 +28,11 @@ selection=()
 targets=()
 if [ "${1:-}" = --readers ]; then
   shift
-  label_regex="^($(IFS='|'; echo "${readers_test_labels[*]}"))\$"
+  label_regex="^($(IFS='|'; echo "${readers_test_programs[*]}")|fuzz)\$"
   selection=(-L "$label_regex")
   # their fuzz targets need every node (scripts/fuzz_build.sh)
   excluded+=('FuzzReplay\.(scenario|sweep)$')
-  targets=(--target core_test hosts_test lcm_probe lcmtypes_test codec_test terrain_readers_test
-    procedural_world_test tiles_test course_test logs_test eval_test
-    "${readers_fuzz_targets[@]/#/nadir_fuzz_replay_}")
+  targets=(--target "${readers_test_programs[@]}" "${readers_fuzz_targets[@]/#/nadir_fuzz_replay_}")
 fi
 
 configure_fuzz_build || exit 1

@@ -14,15 +14,20 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <future>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
+#include <regex>
 #include <streambuf>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/bus.h"
@@ -95,9 +100,11 @@ class LiveLaunch {
     core::BusParams params;
     params.url = url_;
     bus_ = core::openBus(params);
-    heartbeats_ = msg::subscribe<msg::Heartbeat>(
-        *bus_, heartbeat_channel_,
-        [this](const msg::Heartbeat& beat) { pid_[beat.node] = beat.pid; });
+    heartbeats_ = msg::subscribe<msg::Heartbeat>(*bus_, heartbeat_channel_,
+                                                 [this](const msg::Heartbeat& beat) {
+                                                   pid_[beat.node] = beat.pid;
+                                                   sent_[beat.node] = beat.sent;
+                                                 });
     estimates_ =
         msg::subscribe<msg::VoEstimate>(*bus_, kVoChannel, [this](const msg::VoEstimate& e) {
           if (e.status == msg::VoStatus::TRACKING) ++tracking_;
@@ -115,6 +122,13 @@ class LiveLaunch {
   std::string text() const { return text_.text(); }
   int trackingEstimates() const { return tracking_; }
   std::int64_t truthsSeen() const { return truths_seen_; }
+  // What a node's last heartbeat says it sent on a channel.
+  std::int64_t sentBy(const std::string& node, const std::string& channel) const {
+    const auto it = sent_.find(node);
+    if (it == sent_.end()) return 0;
+    const auto count = it->second.find(channel);
+    return count == it->second.end() ? 0 : count->second;
+  }
   // The process of a node by its heartbeats; 0 before its first.
   int pidOf(const std::string& node) const {
     const auto it = pid_.find(node);
@@ -156,6 +170,7 @@ class LiveLaunch {
   std::string truth_channel_;
   std::string camera_channel_;
   std::map<std::string, int> pid_;
+  std::map<std::string, std::map<std::string, std::int64_t>> sent_;
   int tracking_ = 0;
   std::int64_t truths_seen_ = 0;
   core::Subscription heartbeats_;
@@ -202,7 +217,7 @@ std::vector<T> recorded(const std::string& log_path, const std::string& channel)
 // processes said they sent, and the run's metrics show the reset and the gap.
 TEST(LaunchFaults, AKilledVoNodeIsRestartedAndCountsAReset) {
   LiveLaunch launch("restart", 7881,
-                    {"duration_s=16", "vo_direct.enabled=false", "nav.enabled=false"});
+                    {"duration_s=14", "vo_direct.enabled=false", "nav.enabled=false"});
   launch.options().max_restarts = 2;
   launch.start();
   const bool tracking = launch.listenUntil(
@@ -302,12 +317,67 @@ TEST(LaunchFaults, AKilledLoggerStopsTheLaunchAndItsRecordingReads) {
   EXPECT_TRUE(in_order);
 }
 
+// A tmpfs of a given size at a folder, unmounted when done (root only).
+class SmallDisk {
+ public:
+  SmallDisk(const fs::path& at, const std::string& size) : at_(at) {
+    fs::create_directories(at);
+    mounted_ =
+        ::geteuid() == 0 &&
+        std::system(("mount -t tmpfs -o size=" + size + " tmpfs '" + at.string() + "'").c_str()) ==
+            0;
+  }
+  ~SmallDisk() {
+    if (mounted_) std::system(("umount -l '" + at_.string() + "'").c_str());
+  }
+  bool mounted() const { return mounted_; }
+
+ private:
+  fs::path at_;
+  bool mounted_ = false;
+};
+
+// The disk fills while recording (the launch's folder on a 3 MB tmpfs: the
+// camera's frames fill it in seconds): lcm-logger stops at its first failed
+// write; launch says why in its words and that the disk is full, stops every
+// node cleanly, and the recording reads to its last whole event.
+TEST(LaunchFaults, AFullDiskStopsTheLaunchAndItsRecordingReads) {
+  LiveLaunch launch("fulldisk", 7885,
+                    {"duration_s=60", "camera.width=160", "camera.height=120",
+                     "vo_feature.enabled=false", "vo_direct.enabled=false", "nav.enabled=false"});
+  const SmallDisk disk(launch.options().out_dir, "3m");
+  if (!disk.mounted()) GTEST_SKIP() << "mounting a tmpfs needs root";
+  launch.start();
+  const int status = launch.finish();
+  SKIP_WITHOUT_MULTICAST(launch);
+  EXPECT_EQ(status, 1) << launch.text();
+  const std::string text = launch.text();
+  EXPECT_TRUE(contains(text,
+                       "lcm-logger died (exit status 1), its last words: "
+                       "\"lcm_eventlog_write_event: No space left on device\""))
+      << text;
+  EXPECT_TRUE(contains(text, "launch: the disk holding " + launch.options().out_dir + " is full"))
+      << text;
+  EXPECT_TRUE(contains(text, "nadir-sim: exit status 0 (stopped by launch)")) << text;
+  EXPECT_TRUE(contains(text, "nadir-camera: exit status 0 (stopped by launch)")) << text;
+  core::LcmLogReader reader(launch.recording());
+  std::int64_t truths = 0;
+  while (auto event = reader.next()) {
+    if (event->channel == launch.truthChannel()) {
+      msg::decode<msg::Pose>(event->data.data(), event->data.size());
+      ++truths;
+    }
+  }
+  EXPECT_EQ(reader.skippedBytes(), 0) << reader.damageReport();
+  EXPECT_GT(truths, 400);  // the first second at least, before the disk filled
+}
+
 // The camera stopped (SIGSTOP) for a while, then continued: launch reports it
 // silent (no heartbeat) and its channel quiet, at once and not at the next
 // report, then heard and flowing again; the flight ends cleanly.
 TEST(LaunchFaults, AStoppedNodeIsReportedSilentThenHeardAgain) {
   LiveLaunch launch("sigstop", 7883,
-                    {"duration_s=12", "camera.width=160", "camera.height=120",
+                    {"duration_s=8", "camera.width=160", "camera.height=120",
                      "vo_feature.enabled=false", "vo_direct.enabled=false", "nav.enabled=false"});
   launch.options().report_period_s = 60.0;  // what is said comes from the silence, not a report
   launch.start();
@@ -344,7 +414,7 @@ TEST(LaunchFaults, AStoppedNodeIsReportedSilentThenHeardAgain) {
 // cleanly with its recording whole.
 TEST(LaunchFaults, MalformedDatagramsAreDroppedAndCounted) {
   LiveLaunch launch("malformed", 7884,
-                    {"duration_s=10", "camera.width=320", "camera.height=240",
+                    {"duration_s=6", "camera.width=320", "camera.height=240",
                      "vo_direct.enabled=false", "nav.enabled=false"});
   launch.start();
   const bool flying = launch.listenUntil([&] { return launch.truthsSeen() >= 800; });
@@ -396,6 +466,62 @@ TEST(LaunchFaults, MalformedDatagramsAreDroppedAndCounted) {
   EXPECT_TRUE(contains(text, "the recording holds every message the nodes said they sent")) << text;
   // The truth lost nothing for its readers: the foreign times made no gap.
   EXPECT_FALSE(contains(text, "lost " + launch.truthChannel())) << text;
+}
+
+// What a node's last line says it received on a channel and counted lost
+// ("POSE_TRUTH 4001 at 400.0 Hz, 0 lost"); nothing if it does not say.
+std::optional<std::pair<std::int64_t, std::int64_t>> receivedAndLost(const fs::path& node_log,
+                                                                     const std::string& channel) {
+  std::ifstream in(node_log);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string line = lastLineOf("\n" + text, "nadir-");
+  const std::regex pattern("(^|[ ;])" + channel + " ([0-9]+) at [0-9.]+ Hz, ([0-9]+) lost");
+  std::smatch match;
+  if (!std::regex_search(line, match, pattern)) return std::nullopt;
+  return std::pair{std::stoll(match[2].str()), std::stoll(match[3].str())};
+}
+
+// A node that floods the bus (the test: 60 kB datagrams on a channel of its own,
+// 200 a second, ten times the camera's frames, for 5 s of a 10 s flight): what
+// each node received of its inputs and what it counted lost add up to what was
+// sent, channel by channel, so that nothing it lost is silent.
+TEST(LaunchFaults, AFloodLeavesNoLossUncounted) {
+  LiveLaunch launch("flood", 7886,
+                    {"duration_s=10", "camera.width=320", "camera.height=240",
+                     "vo_direct.enabled=false", "nav.enabled=false"});
+  launch.start();
+  const bool flying = launch.listenUntil([&] { return launch.truthsSeen() >= 800; });
+  SKIP_WITHOUT_MULTICAST(launch);
+  ASSERT_TRUE(flying) << launch.text();
+  const std::vector<std::uint8_t> flood(60000, 0x5a);
+  std::int64_t flooded = 0;
+  for (const auto until = Clock::now() + std::chrono::seconds(5); Clock::now() < until;) {
+    launch.bus().publish("FLOOD", flood.data(), flood.size(), 0);
+    ++flooded;
+    launch.bus().handleAvailable();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(launch.finish(), 0) << launch.text();
+  std::printf("flooded %lld datagrams of 60 kB\n", static_cast<long long>(flooded));
+  const fs::path out(launch.options().out_dir);
+  struct Input {
+    std::string node_log;
+    std::string channel;
+    std::string sender;
+  };
+  for (const Input& input : {Input{"camera.log", launch.truthChannel(), "sim"},
+                             Input{"vo_feature.log", launch.truthChannel(), "sim"},
+                             Input{"vo_feature.log", launch.cameraChannel(), "camera"}}) {
+    SCOPED_TRACE(input.node_log + " " + input.channel);
+    const auto counts = receivedAndLost(out / input.node_log, input.channel);
+    ASSERT_TRUE(counts) << "no count of " << input.channel << " in " << input.node_log;
+    const std::int64_t sent = launch.sentBy(input.sender, input.channel);
+    std::printf("%s: %s %lld received, %lld counted lost, of %lld sent\n", input.node_log.c_str(),
+                input.channel.c_str(), static_cast<long long>(counts->first),
+                static_cast<long long>(counts->second), static_cast<long long>(sent));
+    EXPECT_GT(sent, 0);
+    EXPECT_EQ(counts->first + counts->second, sent);
+  }
 }
 
 }  // namespace
