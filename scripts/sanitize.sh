@@ -41,5 +41,6 @@ cmake --build "$build_dir" --parallel "$jobs" "${targets[@]}" >&2 ||
 
 export_sanitizer_options
 exclude_regex="$(IFS='|'; echo "${excluded[*]}")"
-exec ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -E "$exclude_regex" \
+exec ctest --test-dir "$build_dir" --output-on-failure --no-label-summary -j "$jobs" \
+  -E "$exclude_regex" \
   "${selection[@]}" "$@"
