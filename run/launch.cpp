@@ -37,6 +37,9 @@ using Clock = std::chrono::steady_clock;
 // How long the end of a launch waits for the nodes to finish their work and for
 // the recording to hold it, at most.
 constexpr auto kSettleLimit = std::chrono::seconds(120);
+// Once every node is done, a recording that has not grown for this long holds
+// all it will: the logger has written everything it received.
+constexpr auto kRecordingIdle = std::chrono::seconds(5);
 // Less free space than this where the recording is, when the logger dies: the
 // disk is full (lcm-logger stops at its first failed write).
 constexpr std::uintmax_t kFullDisk_bytes = 1 << 20;
@@ -94,6 +97,14 @@ class RecordingCounter {
   std::int64_t count(const std::string& channel) const {
     const auto it = counts_.find(channel);
     return it == counts_.end() ? 0 : it->second;
+  }
+  // Events on every channel but one (the heartbeats, which go on to the end).
+  std::int64_t totalExcept(const std::string& ignored) const {
+    std::int64_t events = 0;
+    for (const auto& [channel, count] : counts_) {
+      if (channel != ignored) events += count;
+    }
+    return events;
   }
 
  private:
@@ -608,8 +619,11 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
         }
         out << "launch: the scenario has ended\n";
         // The nodes finish what they have (a VO behind by some frames), then the
-        // recording must hold all they sent: waited for, not timed.
+        // recording must hold all they sent: waited for, not timed, while the
+        // logger still writes (what it dropped never comes, and is reported).
         const auto settle_deadline = Clock::now() + kSettleLimit;
+        std::int64_t recorded_events = -1;
+        auto recording_grew = Clock::now();
         const auto settled = [&] {
           recording.update();
           for (const LaunchedNode& node : launched) {
@@ -617,7 +631,13 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
             if (report == heartbeats.end()) return false;
             if (isSimulator(node) ? !report->second.done : report->second.working) return false;
           }
-          return !recordingHere() || missingFromRecording(heartbeats, recording).empty();
+          const std::int64_t events = recording.totalExcept(scenario.bus.heartbeat_channel);
+          if (events != recorded_events) {
+            recorded_events = events;
+            recording_grew = Clock::now();
+          }
+          return !recordingHere() || missingFromRecording(heartbeats, recording).empty() ||
+                 Clock::now() - recording_grew > kRecordingIdle;
         };
         while (!stop && !settled() && Clock::now() < settle_deadline) {
           bus->handle(std::chrono::milliseconds(100));
