@@ -20,10 +20,10 @@ void onLaunchSignal(int) { g_stop_launch = true; }
 
 void addLaunchCommand(CLI::App& app) {
   auto options = std::make_shared<run::LaunchOptions>();
-  auto* command = app.add_subcommand(
-      "launch",
-      "Start the scenario's nodes as live processes on UDP LCM with lcm-logger; print "
-      "their health; stop them all at the end or on Ctrl-C");
+  auto* command = app.add_subcommand("launch",
+                                     "Start the scenario's nodes as live processes on UDP LCM, "
+                                     "recorded by `nadir log record`; print "
+                                     "their health; stop them all at the end or on Ctrl-C");
   command->add_option("scenario", options->scenario, "built-in scenario name or YAML file")
       ->capture_default_str();
   command->add_option("--out", options->out_dir,
@@ -46,7 +46,7 @@ void addLaunchCommand(CLI::App& app) {
   auto restart = std::make_shared<bool>(false);
   auto max_restarts = std::make_shared<int>(3);
   command->add_flag("--restart", *restart,
-                    "start a node that dies again (not nadir-sim or lcm-logger: either dying "
+                    "start a node that dies again (not nadir-sim or the logger: either dying "
                     "stops the launch); a VO node's num_resets counts its fresh start");
   command
       ->add_option("--max-restarts", *max_restarts,

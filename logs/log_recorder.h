@@ -2,7 +2,9 @@
 // Records what arrives on a bus into an LCM log, as lcm-logger does (each
 // event stamped with its receive time), and counts per channel what was lost
 // on the way, from the messages' own times and the rate each should keep
-// (given, or learnt: core/stream_gaps.h).
+// (given, or learnt: core/stream_gaps.h). Unlike lcm-logger, whose one
+// subscription keeps LCM's default queue of 30 messages, it queues the bus's
+// queue_capacity: a burst while it waits for the CPU is not dropped.
 
 #include <cstdint>
 #include <map>

@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -41,13 +42,20 @@ constexpr auto kSettleLimit = std::chrono::seconds(120);
 // all it will: the logger has written everything it received.
 constexpr auto kRecordingIdle = std::chrono::seconds(5);
 // Less free space than this where the recording is, when the logger dies: the
-// disk is full (lcm-logger stops at its first failed write).
+// disk is full (the logger stops at its first failed write).
 constexpr std::uintmax_t kFullDisk_bytes = 1 << 20;
 
 std::string programPath(const std::string& bin_dir, const std::string& name) {
   const fs::path path = fs::path(bin_dir) / name;
   if (!fs::exists(path)) throw std::runtime_error("cannot find " + path.string());
   return path.string();
+}
+
+// A rate as `nadir log record --rate` reads it back, to the last digit.
+std::string formatRate(double rate_hz) {
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof(text), rate_hz);
+  return std::string(text, result.ptr);
 }
 
 struct ChannelHealth {
@@ -73,7 +81,7 @@ std::int64_t missingOn(const std::map<std::string, core::ChannelStats>& stats,
   return it == stats.end() ? 0 : it->second.missing;
 }
 
-// The recording's messages by channel, read as lcm-logger writes it: each
+// The recording's messages by channel, read as the logger writes it: each
 // update() reads only what was appended since the last.
 class RecordingCounter {
  public:
@@ -335,12 +343,23 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   // One process per node the scenario runs, each given the scenario and overrides;
   // the simulator starts once the others are up, and the health report expects
   // what the nodes' streams say.
+  // The logger is nadir's own recorder, not lcm-logger: lcm-logger subscribes
+  // with LCM's default queue of 30 messages and drops, uncounted, what a burst
+  // brings beyond it while it waits for the CPU.
   const LaunchHost& logger_host = hosts.hostOf(kLoggerNode);
-  ChildProcess logger(
-      "lcm-logger",
-      hosts.command(logger_host, {"lcm-logger", "--lcm-url=" + url, "-f", recording_path.string()},
-                    bin_dir),
-      nodeLog("lcm-logger"));
+  std::vector<std::string> logger_argv = {programPath(bin_dir, "nadir"),
+                                          "log",
+                                          "record",
+                                          recording_path.string(),
+                                          "--force",
+                                          "--url",
+                                          url};
+  for (const auto& [channel, rate_hz] : nodes::expectedRates(scenario)) {
+    logger_argv.push_back("--rate");
+    logger_argv.push_back(channel + "=" + formatRate(rate_hz));
+  }
+  ChildProcess logger(kLoggerNode, hosts.command(logger_host, logger_argv, bin_dir),
+                      nodeLog(kLoggerNode));
   RecordingCounter recording(recording_path.string());
   std::vector<LaunchedNode> launched;
   std::map<std::string, ChannelHealth> channels;
@@ -462,7 +481,7 @@ int launchScenario(const LaunchOptions& options, std::ostream& out, const std::a
   if (several_hosts) {
     for (const std::string& host : used_hosts) {
       out << "launch: host " << hosts.host(host).describe() << ":";
-      if (host == logger_host.name) out << " lcm-logger";
+      if (host == logger_host.name) out << " " << kLoggerNode;
       for (const std::string& node : nodes_by_host[host]) out << " " << node;
       out << "\n";
     }

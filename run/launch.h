@@ -1,6 +1,6 @@
 #pragma once
 // `nadir launch`: the live mode. Each node runs as its own process on UDP LCM
-// (nadir-sim, nadir-camera, the VO nodes) with lcm-logger recording; their
+// (nadir-sim, nadir-camera, the VO nodes) with `nadir log record` recording; their
 // health (message rates against what the scenario expects, VO status, exit
 // statuses) is printed while they run, and all are stopped cleanly when the
 // scenario ends or on request. A node that dies is reported with its exit
@@ -31,7 +31,7 @@ struct LaunchOptions {
   double bus_check_timeout_s = 20.0;
   // A node that dies is started again, up to this many times each; 0: a dead
   // node stops the launch. Never the simulator (the flight is its) nor
-  // lcm-logger (the recording is its): either dying stops the launch.
+  // the logger (the recording is its): either dying stops the launch.
   int max_restarts = 0;
 };
 

@@ -15,7 +15,8 @@
 
 namespace nadir::run {
 
-// lcm-logger's place in a hosts file (it is no node of the registry).
+// The logger's (`nadir log record`) place in a hosts file (it is no node of the
+// registry).
 inline constexpr char kLoggerNode[] = "logger";
 
 struct LaunchHost {

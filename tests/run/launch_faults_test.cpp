@@ -279,20 +279,20 @@ TEST(LaunchFaults, AKilledLoggerStopsTheLaunchAndItsRecordingReads) {
   const bool flying = launch.listenUntil([&] { return launch.truthsSeen() >= 800; });
   SKIP_WITHOUT_MULTICAST(launch);
   ASSERT_TRUE(flying) << launch.text();
-  // lcm-logger is the process writing this launch's recording.
+  // `nadir log record` is the process writing this launch's recording.
   int logger_pid = 0;
   for (const auto& entry : fs::directory_iterator("/proc")) {
     std::ifstream cmdline(entry.path() / "cmdline");
     std::string words((std::istreambuf_iterator<char>(cmdline)), std::istreambuf_iterator<char>());
-    if (contains(words, "lcm-logger") && contains(words, launch.recording())) {
+    if (contains(words, std::string("log\0record", 10)) && contains(words, launch.recording())) {
       logger_pid = std::stoi(entry.path().filename().string());
     }
   }
-  ASSERT_GT(logger_pid, 0) << "no lcm-logger writing " << launch.recording();
+  ASSERT_GT(logger_pid, 0) << "no logger writing " << launch.recording();
   ASSERT_EQ(::kill(logger_pid, SIGKILL), 0);
   EXPECT_EQ(launch.finish(), 1) << launch.text();
   const std::string text = launch.text();
-  EXPECT_TRUE(contains(text, "lcm-logger died (killed by signal 9)")) << text;
+  EXPECT_TRUE(contains(text, "logger died (killed by signal 9)")) << text;
   EXPECT_TRUE(contains(text, "the recording ends there; stopping every node")) << text;
   EXPECT_TRUE(contains(text, "nadir-sim: exit status 0 (stopped by launch)")) << text;
   EXPECT_TRUE(contains(text, "nadir-camera: exit status 0 (stopped by launch)")) << text;
@@ -338,7 +338,7 @@ class SmallDisk {
 };
 
 // The disk fills while recording (the launch's folder on a 3 MB tmpfs: the
-// camera's frames fill it in seconds): lcm-logger stops at its first failed
+// camera's frames fill it in seconds): the logger stops at its first failed
 // write; launch says why in its words and that the disk is full, stops every
 // node cleanly, and the recording reads to its last whole event.
 TEST(LaunchFaults, AFullDiskStopsTheLaunchAndItsRecordingReads) {
@@ -352,10 +352,11 @@ TEST(LaunchFaults, AFullDiskStopsTheLaunchAndItsRecordingReads) {
   SKIP_WITHOUT_MULTICAST(launch);
   EXPECT_EQ(status, 1) << launch.text();
   const std::string text = launch.text();
-  EXPECT_TRUE(contains(text,
-                       "lcm-logger died (exit status 1), its last words: "
-                       "\"lcm_eventlog_write_event: No space left on device\""))
+  const std::string words = lastLineOf(text, "launch: logger died");
+  EXPECT_TRUE(
+      contains(words, "logger died (exit status 1), its last words: \"nadir: error: cannot "))
       << text;
+  EXPECT_TRUE(contains(words, launch.recording() + ": No space left on device\"")) << text;
   EXPECT_TRUE(contains(text, "launch: the disk holding " + launch.options().out_dir + " is full"))
       << text;
   EXPECT_TRUE(contains(text, "nadir-sim: exit status 0 (stopped by launch)")) << text;
@@ -411,8 +412,8 @@ TEST(LaunchFaults, AStoppedNodeIsReportedSilentThenHeardAgain) {
 // type's message (a wrong fingerprint, with a plausible time), a truncated
 // truth pose and random bytes. Every node drops them, counts them in its status
 // and goes on; launch counts those on the heartbeat channel; the flight ends
-// cleanly. (What the recording holds is the logger's: launch compares it, and
-// the other tests check it whole.)
+// cleanly and the recording holds every message the nodes sent (and the
+// malformed ones: a recording keeps what the bus carried).
 TEST(LaunchFaults, MalformedDatagramsAreDroppedAndCounted) {
   LiveLaunch launch("malformed", 7884,
                     {"duration_s=6", "camera.width=160", "camera.height=120",
@@ -466,6 +467,7 @@ TEST(LaunchFaults, MalformedDatagramsAreDroppedAndCounted) {
       << text;
   // The truth lost nothing for its readers: the foreign times made no gap.
   EXPECT_FALSE(contains(text, "lost " + launch.truthChannel())) << text;
+  EXPECT_TRUE(contains(text, "the recording holds every message the nodes said they sent")) << text;
 }
 
 // What a node's last line says it received on a channel and counted lost

@@ -200,7 +200,7 @@ TEST(LaunchOnHosts, FliesAcrossThreeHosts) {
       << text;
   EXPECT_NE(text.find("  host b:\n    vo_feature: "), std::string::npos) << text;
   EXPECT_NE(text.find("nadir-vo-feature on b: "), std::string::npos) << text;
-  EXPECT_NE(text.find("lcm-logger on c: "), std::string::npos) << text;
+  EXPECT_NE(text.find("logger on c: "), std::string::npos) << text;
   EXPECT_NE(text.find("the recording holds every message the nodes said they sent"),
             std::string::npos)
       << text;

@@ -562,6 +562,7 @@ TEST(Launch, ADeadNodeIsReported) {
          "exit 3\n";
   fs::permissions(bin / "nadir-camera", fs::perms::owner_all);
   fs::create_symlink(fs::path(NADIR_BIN_DIR) / "nadir-sim", bin / "nadir-sim");
+  fs::create_symlink(fs::path(NADIR_BIN_DIR) / "nadir", bin / "nadir");  // the logger
   LaunchOptions options;
   options.scenario = "default";
   options.out_dir = (fs::path(dir) / "out").string();
