@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <type_traits>
 
@@ -175,6 +177,48 @@ Pose poseFromLcm(const nadir::pose_t& in) {
 
 // ---------------------------------------------------------------- image_t
 
+struct JpegFrameSize {
+  int width = 0;
+  int height = 0;
+};
+
+// The frame size a JPEG declares in its start-of-frame marker, read before
+// anything is decoded; nothing when the bytes hold no whole one before the scan.
+std::optional<JpegFrameSize> jpegFrameSize(const std::vector<std::uint8_t>& jpeg) {
+  const std::size_t size = jpeg.size();
+  if (size < 4 || jpeg[0] != 0xFF || jpeg[1] != 0xD8) return std::nullopt;
+  std::size_t at = 2;
+  while (at + 4 <= size) {
+    if (jpeg[at] != 0xFF) return std::nullopt;
+    const std::uint8_t marker = jpeg[at + 1];
+    if (marker == 0xFF) {  // a fill byte before the marker
+      ++at;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // no length
+      at += 2;
+      continue;
+    }
+    if (marker == 0xDA || marker == 0xD9) return std::nullopt;  // the scan, the end
+    const std::size_t length = (std::size_t{jpeg[at + 2]} << 8) | jpeg[at + 3];
+    if (length < 2 || at + 2 + length > size) return std::nullopt;
+    const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+                       marker != 0xCC;  // C4, C8, CC: Huffman tables, reserved, arithmetic
+    if (frame) {
+      if (length < 7) return std::nullopt;
+      const std::uint8_t* header = jpeg.data() + at + 4;  // precision, height, width
+      return JpegFrameSize{(header[3] << 8) | header[4], (header[1] << 8) | header[2]};
+    }
+    at += 2 + length;
+  }
+  return std::nullopt;
+}
+
+// A Huffman-coded JPEG spends at least one bit on each 8x8 block of each
+// component, so n bytes hold at most 512 n pixels; a few hundred bytes that
+// declare more would have a node decode gigapixels of nothing.
+constexpr std::int64_t kMaxJpegPixelsPerByte = 512;
+
 Image imageFromLcm(const nadir::image_t& message) {
   const auto fail = [&](const std::string& what) {
     return InvalidMessage("image_t " + std::to_string(message.width) + "x" +
@@ -192,6 +236,16 @@ Image imageFromLcm(const nadir::image_t& message) {
   }
   if (message.width <= 0 || message.height <= 0) throw fail("no pixels");
   if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_MJPEG) {
+    const std::optional<JpegFrameSize> frame = jpegFrameSize(message.data);
+    if (!frame) throw fail("JPEG data has no frame header");
+    if (frame->width != message.width || frame->height != message.height) {
+      throw fail("JPEG is " + std::to_string(frame->width) + "x" + std::to_string(frame->height));
+    }
+    if (std::int64_t{message.width} * message.height >
+        kMaxJpegPixelsPerByte * static_cast<std::int64_t>(message.data.size())) {
+      throw fail("a JPEG of " + std::to_string(message.data.size()) + " bytes cannot hold " +
+                 std::to_string(std::int64_t{message.width} * message.height) + " pixels");
+    }
     cv::Mat decoded = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
     if (decoded.empty()) throw fail("JPEG data does not decode");
     if (decoded.cols != message.width || decoded.rows != message.height) {

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -267,6 +268,43 @@ TEST(Codec, MalformedImagesAreRefused) {
   nadir::image_t bad_jpeg = message;
   bad_jpeg.pixelformat = nadir::image_t::PIXEL_FORMAT_MJPEG;
   EXPECT_NE(invalidReason<Image>(bad_jpeg).find("JPEG"), std::string::npos);
+}
+
+// A JPEG's frame header is read before anything is decoded: a frame size other
+// than the message's, a header missing, or more pixels than the bytes can hold
+// (a Huffman JPEG spends at least one bit per 8x8 block: 512 pixels a byte) is
+// refused without decoding.
+TEST(Codec, AJpegIsCheckedBeforeItIsDecoded) {
+  const nadir::image_t message = asLcm<nadir::image_t>(encode(Image{0, gradient(1), 90, {}}));
+  ASSERT_EQ(message.pixelformat, std::int32_t{nadir::image_t::PIXEL_FORMAT_MJPEG});
+  nadir::image_t wider = message;
+  wider.width = 65;
+  EXPECT_NE(invalidReason<Image>(wider).find("JPEG is 64x48"), std::string::npos)
+      << invalidReason<Image>(wider);
+  nadir::image_t cut = message;
+  cut.data.resize(20);  // the start and part of the first table
+  cut.size = 20;
+  EXPECT_NE(invalidReason<Image>(cut).find("JPEG data has no frame header"), std::string::npos)
+      << invalidReason<Image>(cut);
+  // The baseline frame marker FF C0, then length (2), precision (1), height, width.
+  nadir::image_t huge = message;
+  const std::uint8_t baseline_frame[] = {0xFF, 0xC0};
+  const auto sof = std::search(huge.data.begin(), huge.data.end(), std::begin(baseline_frame),
+                               std::end(baseline_frame));
+  ASSERT_NE(sof, huge.data.end());
+  const std::size_t at = static_cast<std::size_t>(sof - huge.data.begin()) + 5;
+  ASSERT_EQ(huge.data[at] * 256 + huge.data[at + 1], 48);
+  ASSERT_EQ(huge.data[at + 2] * 256 + huge.data[at + 3], 64);
+  huge.data[at] = 0x2F;  // 12040 rows
+  huge.data[at + 1] = 0x08;
+  huge.data[at + 2] = 0x3A;  // 14895 columns
+  huge.data[at + 3] = 0x2F;
+  huge.width = 14895;
+  huge.height = 12040;
+  ASSERT_LT(huge.data.size(), 179'335'800u / 512);
+  EXPECT_NE(invalidReason<Image>(huge).find(" bytes cannot hold 179335800 pixels"),
+            std::string::npos)
+      << invalidReason<Image>(huge);
 }
 
 // A count or string length in the bytes that the bytes cannot hold is a
