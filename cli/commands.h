@@ -28,6 +28,7 @@ void addLogCommands(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addVoCommands(CLI::App& app);
 void addCalibCommand(CLI::App& app);
+void addSpyCommand(CLI::App& app);
 
 // nadir run's and nadir demo's progress line, on stderr, and its end.
 void printRunProgress(const run::RunProgress& progress);

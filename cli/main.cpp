@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   nadir::cli::addEvalCommand(app);
   nadir::cli::addVoCommands(app);
   nadir::cli::addCalibCommand(app);
+  nadir::cli::addSpyCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
