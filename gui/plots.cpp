@@ -7,8 +7,10 @@
 #include <QLegend>
 #include <QLegendMarker>
 #include <QLineSeries>
+#include <QList>
 #include <QPainter>
 #include <QPen>
+#include <QPointF>
 #include <QVBoxLayout>
 #include <QValueAxis>
 #include <QWidget>
@@ -21,7 +23,10 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
+
+#include "gui/line_thinning.h"
 
 namespace nadir::gui {
 
@@ -77,8 +82,10 @@ void setAxisRange(QValueAxis* axis, double lo, double hi) {
   axis->setRange(lo, hi);
 }
 
-// Enough points for a 1200 px wide chart; more only slow the drawing down.
-constexpr std::size_t kMaxPointsPerSeries = 4000;
+// The pixels a line is thinned for while the chart's plot area is not known (it
+// is laid out when first shown): as many as a wide screen's chart, so that the
+// first picture already shows every spike.
+constexpr int kPixelsBeforeLayout = 2000;
 // A line is broken where samples are further apart than this (a gap in the
 // estimates), so that no pose is drawn where there was none.
 constexpr double kMaxGap_s = 1.0;
@@ -96,11 +103,89 @@ struct Range {
   bool empty() const { return min > max; }
 };
 
-// One chart with value axes; every line added goes on both axes.
+// How a chart's lines are thinned (gui/line_thinning.h): against time, M4 per
+// pixel column of the x axis; or as a path in the plane (the top view), to half
+// a pixel on each axis.
+enum class Thinning { kTimeSeries, kPath };
+
+// A piece of a line drawn unbroken: every point of it, and the series that draws
+// those kept for the current view.
+struct LineSegment {
+  QLineSeries* series = nullptr;
+  std::vector<PlotPoint> points;
+};
+
+// The whole segment in view, at kPixelsBeforeLayout: its drawing before the chart
+// has axis ranges and a plot area.
+PlotView wholeSegmentView(const std::vector<PlotPoint>& points) {
+  PlotView view{points.front().x, points.front().x,    points.front().y,
+                points.front().y, kPixelsBeforeLayout, kPixelsBeforeLayout};
+  for (const PlotPoint& point : points) {
+    view.x_lo = std::min(view.x_lo, point.x);
+    view.x_hi = std::max(view.x_hi, point.x);
+    view.y_lo = std::min(view.y_lo, point.y);
+    view.y_hi = std::max(view.y_hi, point.y);
+  }
+  return view;
+}
+
+// Draws the segment's points kept for the view; one replace() for the whole list,
+// as appending point by point redraws at each.
+void drawThinned(Thinning thinning, const LineSegment& segment, const PlotView& view) {
+  const std::vector<std::size_t> kept =
+      thinning == Thinning::kTimeSeries
+          ? keptTimeSeriesPoints(segment.points, view.x_lo, view.x_hi, view.width_px)
+          : keptPathPointsInView(segment.points, view);
+  QList<QPointF> drawn;
+  drawn.reserve(static_cast<qsizetype>(kept.size()));
+  for (const std::size_t i : kept) drawn.append(QPointF(segment.points[i].x, segment.points[i].y));
+  segment.series->replace(drawn);
+}
+
+// Re-thins every segment of the chart from its full points whenever what they
+// are drawn for changes: the x range (a path's y range too) or the plot area's
+// size. Replacing points changes neither, so this starts no loop with the
+// axes' other handlers (keepRoundTicks, keepEqualScale).
+void keepThinned(QChart* chart, QValueAxis* x_axis, QValueAxis* y_axis, Thinning thinning,
+                 std::shared_ptr<const std::vector<LineSegment>> segments) {
+  auto drawn_for = std::make_shared<std::optional<PlotView>>();
+  const auto rethin = [=] {
+    const QRectF area = chart->plotArea();
+    const auto pixels = [&](double length_px) {
+      return area.isEmpty() ? kPixelsBeforeLayout
+                            : std::max(1, static_cast<int>(std::lround(length_px)));
+    };
+    PlotView view;
+    view.x_lo = x_axis->min();
+    view.x_hi = x_axis->max();
+    view.width_px = pixels(area.width());
+    // A time series is thinned along x only: its y range and height change nothing.
+    if (thinning == Thinning::kPath) {
+      view.y_lo = y_axis->min();
+      view.y_hi = y_axis->max();
+      view.height_px = pixels(area.height());
+    }
+    // The plot area changes with every layout, mostly not its width.
+    if (*drawn_for == view) return;
+    *drawn_for = view;
+    for (const LineSegment& segment : *segments) drawThinned(thinning, segment, view);
+  };
+  rethin();
+  QObject::connect(x_axis, &QValueAxis::rangeChanged, chart, rethin);
+  if (thinning == Thinning::kPath) {
+    QObject::connect(y_axis, &QValueAxis::rangeChanged, chart, rethin);
+  }
+  // Queued: the chart is laying itself out when it says its plot area changed.
+  QObject::connect(chart, &QChart::plotAreaChanged, chart, rethin, Qt::QueuedConnection);
+}
+
+// One chart with value axes; every line added goes on both axes, drawn thinned
+// to the points that make its pixels (re-thinned on every zoom and pan).
 class ChartBuilder {
  public:
-  ChartBuilder(const QString& title, const QString& x_title, const QString& y_title)
-      : chart_(std::make_unique<QChart>()) {
+  ChartBuilder(const QString& title, const QString& x_title, const QString& y_title,
+               Thinning thinning = Thinning::kTimeSeries)
+      : chart_(std::make_unique<QChart>()), thinning_(thinning) {
     chart_->setTitle(title);
     chart_->legend()->setVisible(true);
     chart_->legend()->setAlignment(Qt::AlignRight);
@@ -118,39 +203,35 @@ class ChartBuilder {
   void addLine(const QString& name, const QColor& color, double width, const std::vector<double>& t,
                const std::vector<double>& x, const std::vector<double>& y, bool wraps = false) {
     const std::size_t n = std::min(x.size(), y.size());
-    const std::size_t stride =
-        std::max<std::size_t>(1, (n + kMaxPointsPerSeries - 1) / kMaxPointsPerSeries);
     QPen pen(color);
     pen.setWidthF(width);
-    QLineSeries* segment = nullptr;
+    std::vector<PlotPoint> points;  // of the segment being gathered
     bool named = false;
     std::size_t last = 0;
     const auto finish = [&] {
-      if (segment == nullptr) return;
-      attach(segment, named);
+      if (points.empty()) return;
+      auto* series = new QLineSeries;
+      series->setName(name);
+      series->setPen(pen);
+      LineSegment& segment = segments_->emplace_back(LineSegment{series, std::move(points)});
+      points.clear();
+      // Drawn before attaching: the axes' first ranges come from the series.
+      drawThinned(thinning_, segment, wholeSegmentView(segment.points));
+      attach(series, named);
       named = true;
-      segment = nullptr;
     };
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(x[i]) || !std::isfinite(y[i])) {
         finish();
         continue;
       }
-      if (segment != nullptr) {
+      if (!points.empty()) {
         const bool gap = !t.empty() && t[i] - t[last] > kMaxGap_s;
         const bool wrap = wraps && std::abs(y[i] - y[last]) > 180.0;
-        if (gap || wrap) {
-          finish();
-        } else if (i - last < stride && i + 1 < n) {
-          continue;
-        }
+        if (gap || wrap) finish();
       }
-      if (segment == nullptr) {
-        segment = new QLineSeries;
-        segment->setName(name);
-        segment->setPen(pen);
-      }
-      segment->append(x[i], y[i]);
+      points.push_back({x[i], y[i]});
+      // The axes fit every point, not only those drawn.
       x_range_.add(x[i]);
       y_range_.add(y[i]);
       last = i;
@@ -168,17 +249,21 @@ class ChartBuilder {
   Range xRange() const { return x_range_; }
   Range yRange() const { return y_range_; }
 
-  // Fits the axes to the data drawn, with round tick values.
+  // Fits the axes to the data, with round tick values.
   std::unique_ptr<QChart> take() {
     setRange(x_axis_, x_range_, 0.0);
     setRange(y_axis_, y_range_, 0.05);
     keepRoundTicks(chart_.get(), x_axis_);
     keepRoundTicks(chart_.get(), y_axis_);
+    keepThinned(chart_.get(), x_axis_, y_axis_, thinning_, segments_);
     return std::move(chart_);
   }
 
-  // The axes left to the caller.
-  std::unique_ptr<QChart> takeAsIs() { return std::move(chart_); }
+  // The axes' ranges and ticks left to the caller.
+  std::unique_ptr<QChart> takeAsIs() {
+    keepThinned(chart_.get(), x_axis_, y_axis_, thinning_, segments_);
+    return std::move(chart_);
+  }
 
   QValueAxis* xAxis() const { return x_axis_; }
   QValueAxis* yAxis() const { return y_axis_; }
@@ -207,6 +292,10 @@ class ChartBuilder {
   }
 
   std::unique_ptr<QChart> chart_;
+  Thinning thinning_;
+  // Shared with the chart's re-thinning, which outlives the builder.
+  std::shared_ptr<std::vector<LineSegment>> segments_ =
+      std::make_shared<std::vector<LineSegment>>();
   QValueAxis* x_axis_ = nullptr;
   QValueAxis* y_axis_ = nullptr;
   Range x_range_;
@@ -392,7 +481,7 @@ Figure errorFigure(const RunData& run, const HiddenTrajectories& hidden) {
 Figure topViewFigure(const RunData& run, const HiddenTrajectories& hidden) {
   Figure figure;
   figure.name = "top_view";
-  ChartBuilder chart("Top view: " + runName(run), "east y (m)", "north x (m)");
+  ChartBuilder chart("Top view: " + runName(run), "east y (m)", "north x (m)", Thinning::kPath);
   const FigureColumns truth = figureColumns(run.truth);
   const std::vector<double> truth_t = sinceStart(truth.t_s, run.t0_s);
   if (!hidden.contains(run.truth_name)) {

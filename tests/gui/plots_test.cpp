@@ -10,12 +10,14 @@
 
 #include <gtest/gtest.h>
 
-#include <set>
-
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "gui_test_util.h"
 
@@ -263,6 +265,105 @@ TEST_F(GuiPlots, AxesKeepRoundTicksAfterZoom) {
       }
     }
   }
+}
+
+// Every point the chart's line series draw, all segments together.
+std::vector<QPointF> drawnPoints(const QChart* chart) {
+  std::vector<QPointF> points;
+  for (QAbstractSeries* series : chart->series()) {
+    if (const auto* line = qobject_cast<const QLineSeries*>(series)) {
+      for (const QPointF& point : line->points()) points.push_back(point);
+    }
+  }
+  return points;
+}
+
+bool drawsPoint(const QChart* chart, double x, double y) {
+  const std::vector<QPointF> points = drawnPoints(chart);
+  return std::any_of(points.begin(), points.end(), [&](const QPointF& point) {
+    return std::abs(point.x() - x) < 1e-6 && std::abs(point.y() - y) < 1e-6;
+  });
+}
+
+// A long run: 100 000 samples at 10 Hz (t = 0 to 9999.9 s), all 1 m but one of
+// 51 m at t = 6123.4 s (sample 61234). The old thinning to every 25th sample
+// lost it (61234 is no multiple of 25).
+constexpr int kLongRunSamples = 100000;
+constexpr int kSpikeSample = 61234;
+constexpr double kSpikeTime_s = 6123.4;
+
+// The error figure of the long run draws the spike over the whole run, zoomed to
+// a window about it, and not in a window away from it, where the line still runs
+// to both edges. The axes fit every sample (0 to 51 m * 1.05 = 53.55 m).
+TEST_F(GuiPlots, AnErrorSpikeIsDrawnAtEveryZoom) {
+  RunData run;
+  SourceSeries& source = run.sources["vo_test"];
+  for (int i = 0; i < kLongRunSamples; ++i) {
+    logs::SourceEstimate estimate;
+    estimate.t_s = 0.1 * i;
+    estimate.status = logs::SourceEstimate::kTracking;
+    source.estimates.push_back(estimate);
+    source.position_error_m.push_back(i == kSpikeSample ? 51.0 : 1.0);
+  }
+  const std::unique_ptr<QWidget> widget = figureWidget(errorFigure(run));
+  widget->setAttribute(Qt::WA_DontShowOnScreen);
+  widget->resize(1200, 800);
+  widget->show();
+  for (int i = 0; i < 3; ++i) QApplication::processEvents();
+  QChart* chart = widget->findChild<QChartView*>()->chart();
+  auto* x = static_cast<QValueAxis*>(chart->axes(Qt::Horizontal).front());
+  const auto* y = static_cast<const QValueAxis*>(chart->axes(Qt::Vertical).front());
+  EXPECT_NEAR(x->min(), 0.0, 1e-9);
+  EXPECT_NEAR(x->max(), 9999.9, 1e-9);
+  EXPECT_NEAR(y->max(), 53.55, 1e-9);
+
+  EXPECT_TRUE(drawsPoint(chart, kSpikeTime_s, 51.0));
+  // At most 4 points per pixel column of the plot area, plus the 2 outside it.
+  const double width_px = chart->plotArea().width();
+  ASSERT_GT(width_px, 0.0);
+  EXPECT_LE(drawnPoints(chart).size(), 4 * static_cast<std::size_t>(std::lround(width_px)) + 2);
+
+  for (const auto& [lo_s, hi_s, spike_inside] :
+       {std::tuple(6100.0, 6150.0, true), std::tuple(7000.0, 7050.0, false)}) {
+    x->setRange(lo_s, hi_s);
+    for (int i = 0; i < 3; ++i) QApplication::processEvents();
+    EXPECT_EQ(drawsPoint(chart, kSpikeTime_s, 51.0), spike_inside) << lo_s;
+    const std::vector<QPointF> points = drawnPoints(chart);
+    ASSERT_FALSE(points.empty()) << lo_s;
+    const auto [left, right] =
+        std::minmax_element(points.begin(), points.end(),
+                            [](const QPointF& a, const QPointF& b) { return a.x() < b.x(); });
+    // The samples just outside the window: 0.1 s before and after it.
+    EXPECT_NEAR(left->x(), lo_s - 0.1, 1e-6) << lo_s;
+    EXPECT_NEAR(right->x(), hi_s + 0.1, 1e-6) << lo_s;
+  }
+}
+
+// The top view of a long flight north (0.1 m a sample, 0 to 9999.9 m) with one
+// sample 50 m east, at north 6123.4 m, draws that sample, also zoomed to a 40 px
+// square about it (about 600 m across: some 6000 samples in view), with far fewer
+// points than the flight has.
+TEST_F(GuiPlots, ATopViewExcursionIsDrawnAtEveryZoom) {
+  RunData run;
+  for (int i = 0; i < kLongRunSamples; ++i) {
+    const double east_m = i == kSpikeSample ? 50.0 : 0.0;
+    run.truth.push_back({0.1 * i, Eigen::Vector3d(0.1 * i, east_m, -100.0), test::attitude()});
+  }
+  const std::unique_ptr<QWidget> widget = figureWidget(topViewFigure(run));
+  widget->setAttribute(Qt::WA_DontShowOnScreen);
+  widget->resize(1200, 800);
+  widget->show();
+  for (int i = 0; i < 3; ++i) QApplication::processEvents();
+  QChart* chart = widget->findChild<QChartView*>()->chart();
+  const auto* x = static_cast<const QValueAxis*>(chart->axes(Qt::Horizontal).front());
+  EXPECT_TRUE(drawsPoint(chart, 50.0, kSpikeTime_s));
+  EXPECT_LT(drawnPoints(chart).size(), static_cast<std::size_t>(kLongRunSamples) / 10);
+  const QPointF spike_px = chart->mapToPosition(QPointF(50.0, kSpikeTime_s));
+  chart->zoomIn(QRectF(spike_px - QPointF(20, 20), QSizeF(40, 40)));
+  for (int i = 0; i < 3; ++i) QApplication::processEvents();
+  EXPECT_LT(x->max() - x->min(), 2000.0);  // zoomed in from 15 900 m
+  EXPECT_TRUE(drawsPoint(chart, 50.0, kSpikeTime_s));
+  EXPECT_LT(drawnPoints(chart).size(), static_cast<std::size_t>(kLongRunSamples) / 10);
 }
 
 TEST_F(GuiPlots, AnUnwritablePathIsNamed) {
