@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/frame_option.h"
 #include "core/params.h"
 #include "logs/eval/metrics.h"
 #include "logs/eval/run_metrics.h"
@@ -104,6 +105,7 @@ void addEvalCommand(CLI::App& app) {
                    "TUM association: largest stamp difference of a pose pair, s")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  addFrameOption(command, options->eval.tum_axes, "the TUM files written");
   command->callback([options] {
     const bool pair = !options->ref.empty() || !options->est.empty();
     if (pair && !options->path.empty()) {

@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include "cli/frame_option.h"
 #include "logs/export/export.h"
 
 namespace nadir::cli {
@@ -25,6 +26,7 @@ struct ExportCommandOptions {
   std::string camera = "CAMERA_DOWN";
   std::string truth = "POSE_TRUTH";
   std::string imu = "IMU";
+  core::Axes axes = core::Axes::kNed;
 };
 
 void runExport(const ExportCommandOptions& options) {
@@ -42,6 +44,7 @@ void runExport(const ExportCommandOptions& options) {
   export_options.camera_channel = options.camera;
   export_options.truth_channel = options.truth;
   export_options.imu_channel = options.imu;
+  export_options.axes = options.axes;
   const bool terminal = isatty(fileno(stdout)) != 0;
   export_options.progress = [terminal](std::int64_t written, std::int64_t total) {
     if (terminal && (written % 50 == 0 || written == total)) {
@@ -79,6 +82,7 @@ void addExportCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--truth", options->truth, "pose_t truth channel")->capture_default_str();
   command->add_option("--imu", options->imu, "imu_t channel")->capture_default_str();
+  addFrameOption(command, options->axes, "every pose, vector and extrinsic written");
   command->callback([options] { runExport(*options); });
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/frame_option.h"
 #include "run/run.h"
 
 namespace nadir::cli {
@@ -54,6 +55,7 @@ void addRunCommand(CLI::App& app) {
   command->add_flag("--force", options->force, "replace an earlier run in the output folder");
   command->add_flag("--no-images{false}", options->record_images,
                     "leave the camera images out of run.lcmlog (metrics are unchanged)");
+  addFrameOption(command, options->tum_axes, "the TUM files written");
   command->callback([options] {
     const run::RunResult result = run::runScenario(*options, printRunProgress);
     endRunProgress();

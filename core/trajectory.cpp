@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <string_view>
 
 #include "core/frames.h"
@@ -114,17 +115,52 @@ void requireIncreasing(const Trajectory& trajectory, const std::string& source,
   }
 }
 
+namespace {
+
+// A TUM file's "# frame: world=W body=B" line, as writeTum writes it.
+void readFrameLine(const std::string& line, const std::string& where, Axes& axes, BodyAxes& body) {
+  std::istringstream words(line.substr(line.find("frame:") + 6));
+  std::string world_word, body_word;
+  words >> world_word >> body_word;
+  if (!world_word.starts_with("world=") || !body_word.starts_with("body=")) {
+    throw TrajectoryError(where + "a frame line is '# frame: world=ned|enu body=frd|flu|camera'");
+  }
+  try {
+    axes = parseAxes(world_word.substr(6));
+  } catch (const std::invalid_argument& error) {
+    throw TrajectoryError(where + error.what());
+  }
+  const std::string body_name = body_word.substr(5);
+  if (body_name == "camera") {
+    body = BodyAxes::kCamera;
+  } else if (body_name == (axes == Axes::kEnu ? "flu" : "frd")) {
+    body = BodyAxes::kVehicle;
+  } else {
+    throw TrajectoryError(where + "body '" + body_name + "' does not go with world " +
+                          axesName(axes) + " (" + (axes == Axes::kEnu ? "flu" : "frd") +
+                          " or camera)");
+  }
+}
+
+}  // namespace
+
 Trajectory readTum(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw TrajectoryError(path + ": cannot open the file for reading");
   Trajectory trajectory;
+  Axes axes = Axes::kNed;
+  BodyAxes body = BodyAxes::kVehicle;
   std::string line;
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
     const std::vector<std::string_view> fields = splitFields(line);
-    if (fields.empty() || fields.front().starts_with('#')) continue;
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    if (!fields.empty() && fields.front().starts_with('#')) {
+      if (line.starts_with("# frame:")) readFrameLine(line, where, axes, body);
+      continue;
+    }
+    if (fields.empty()) continue;
     if (fields.size() != 8) {
       throw TrajectoryError(where + "expected 8 numbers (t tx ty tz qx qy qz qw), got " +
                             std::to_string(fields.size()) + " fields");
@@ -155,16 +191,25 @@ Trajectory readTum(const std::string& path) {
   }
   if (in.bad()) throw TrajectoryError(path + ": read error");
   if (trajectory.empty()) throw TrajectoryError(path + ": no poses in the file");
+  if (axes != Axes::kNed) {
+    for (StampedPose& pose : trajectory) {
+      pose.p_ned_m = worldVectorToNed(axes, pose.p_ned_m);
+      pose.q_world_body = attitudeToNed(axes, pose.q_world_body, body);
+    }
+  }
   return trajectory;
 }
 
-void writeTum(const std::string& path, const Trajectory& trajectory) {
+void writeTum(const std::string& path, const Trajectory& trajectory, Axes axes, BodyAxes body) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw TrajectoryError(path + ": cannot open the file for writing");
-  std::string text;
+  std::string text =
+      "# t tx ty tz qx qy qz qw: time (s), position (m), orientation (Hamilton), T_world_body\n"
+      "# " +
+      frameWords(axes, body) + "\n# frame: " + frameTag(axes, body) + "\n";
   for (const StampedPose& pose : trajectory) {
-    const Eigen::Vector3d& p = pose.p_ned_m;
-    const Eigen::Quaterniond& q = pose.q_world_body;
+    const Eigen::Vector3d p = worldVectorIn(axes, pose.p_ned_m);
+    const Eigen::Quaterniond q = attitudeIn(axes, pose.q_world_body, body);
     const std::array<double, 8> v{pose.t_s, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
     for (std::size_t i = 0; i < v.size(); ++i) {
       if (i > 0) text += ' ';

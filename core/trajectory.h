@@ -14,6 +14,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/axes.h"
+
 namespace nadir::core {
 
 class LocalNedFrame;
@@ -65,12 +67,16 @@ void requireIncreasing(const Trajectory& trajectory, const std::string& source,
 
 // A TUM file: fields separated by spaces, tabs or commas; blank lines and
 // lines starting with '#' skipped. Quaternions are normalised (a zero one is an
-// error); times must increase strictly; at least one pose.
+// error); times must increase strictly; at least one pose. A "# frame: world=enu
+// body=flu" line (writeTum's) says the file's axes: its poses come back in
+// nadir's (core/axes.h); without one they are taken as nadir's.
 Trajectory readTum(const std::string& path);
 
 // "t tx ty tz qx qy qz qw" lines in the shortest text that reads back to the
-// same doubles.
-void writeTum(const std::string& path, const Trajectory& trajectory);
+// same doubles, in the given axes (the trajectory is in nadir's), after a
+// header that says them in a frame line.
+void writeTum(const std::string& path, const Trajectory& trajectory, Axes axes = Axes::kNed,
+              BodyAxes body = BodyAxes::kVehicle);
 
 // A flight CSV: a header naming at least time_s, lat_deg, lon_deg, alt_m
 // (ellipsoid), roll_deg, pitch_deg, yaw_deg (Z-Y-X), in any order, extra

@@ -150,8 +150,10 @@ RunResult runScenario(const RunOptions& options,
   report(true);
   log.flush();
 
-  const eval::RunEvaluation evaluation = eval::evaluateRunLog(
-      result.log_path, out.string(), eval::EvalOptions{}, scenario.sim.truth.channel);
+  eval::EvalOptions eval_options;
+  eval_options.tum_axes = options.tum_axes;
+  const eval::RunEvaluation evaluation =
+      eval::evaluateRunLog(result.log_path, out.string(), eval_options, scenario.sim.truth.channel);
   result.metrics = evaluation.metrics;
   result.metrics_path = evaluation.metrics_path;
   result.tum_paths = evaluation.tum_paths;

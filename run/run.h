@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/axes.h"
 #include "logs/eval/run_metrics.h"
 
 namespace nadir::nodes {
@@ -29,6 +30,9 @@ struct RunOptions {
   // Leave the camera images out of run.lcmlog (everything else is recorded):
   // for sweeps, where a 1280x960 stream would write 38 MB per second of flight.
   bool record_images = true;
+  // The axes of the TUM files written (core/axes.h); the log and metrics are
+  // nadir's whatever they are.
+  core::Axes tum_axes = core::Axes::kNed;
 };
 
 struct RunProgress {

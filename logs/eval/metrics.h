@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/axes.h"
 #include "logs/eval/alignment.h"
 #include "logs/eval/trajectory.h"
 
@@ -52,6 +53,9 @@ struct EvalOptions {
   // s; 0 uses every estimate. Sampled finely, a pixel's jitter in a 200 Hz
   // estimate adds to its path what the flight did not fly.
   double track_length_interval_s = 1.0;
+  // The axes of the TUM files a run's evaluation writes (the metrics are the
+  // same in either): nadir's NED/FRD or REP-103's ENU/FLU (core/axes.h).
+  core::Axes tum_axes = core::Axes::kNed;
 };
 // Throws EvalError naming the bad option (unknown align or unit, delta <= 0,
 // a fractional delta in frames, t_max_diff_s < 0, ...).

@@ -560,12 +560,12 @@ RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out
   run.metrics_path = (dir / "metrics.json").string();
   writeMetricsJson(run.metrics_path, run.metrics, options);
   run.tum_paths.push_back((dir / "truth.tum").string());
-  core::writeTum(run.tum_paths.back(), run.recorded.truth);
+  core::writeTum(run.tum_paths.back(), run.recorded.truth, options.tum_axes);
   for (const auto& [name, estimates] : run.recorded.sources) {
     core::Trajectory tracked = logs::trackingTrajectory(estimates);
     if (tracked.empty()) continue;  // never tracked: a TUM file needs at least one pose
     run.tum_paths.push_back((dir / (name + ".tum")).string());
-    core::writeTum(run.tum_paths.back(), tracked);
+    core::writeTum(run.tum_paths.back(), tracked, options.tum_axes);
     run.tracked.emplace(name, std::move(tracked));
   }
   return run;

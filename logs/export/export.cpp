@@ -323,10 +323,12 @@ double medianRateHz(const std::vector<msg::Imu>& samples) {
 // Ground truth of the camera at each image time: T_world_cam = T_world_body * T_body_cam.
 void writeTumTrajectory(Context& context, const fs::path& path) {
   TextFile file(path);
-  file << "# ground truth: pose of the camera (OpenCV optical frame: x right, y down, z along the "
-          "optical axis) in nadir's world frame (local NED), T_world_cam, interpolated at the "
-          "image times\n";
+  const core::Axes axes = context.options.axes;
+  file << "# ground truth: pose of the camera in the world, T_world_cam, interpolated at the "
+          "image times; " +
+              core::frameWords(axes, core::BodyAxes::kCamera) + "\n";
   file << "# " + sourceLine(context) + ", truth from " + context.options.truth_channel + "\n";
+  file << "# frame: " + core::frameTag(axes, core::BodyAxes::kCamera) + "\n";
   file << "# timestamp tx ty tz qx qy qz qw\n";
   std::int64_t missing = 0;
   core::Trajectory truth;
@@ -344,8 +346,9 @@ void writeTumTrajectory(Context& context, const fs::path& path) {
     T_world_body.linear() = body->q_world_body.toRotationMatrix();
     T_world_body.translation() = body->p_ned_m;
     const Eigen::Isometry3d T_world_cam = T_world_body * context.calibration.T_body_cam;
-    const Eigen::Vector3d p = T_world_cam.translation();
-    const Eigen::Quaterniond q(T_world_cam.rotation());
+    const Eigen::Vector3d p = core::worldVectorIn(axes, T_world_cam.translation());
+    const Eigen::Quaterniond q =
+        core::attitudeIn(axes, Eigen::Quaterniond(T_world_cam.rotation()), core::BodyAxes::kCamera);
     file << secondsText(image.utime) + " " + number(p.x()) + " " + number(p.y()) + " " +
                 number(p.z()) + " " + number(q.x()) + " " + number(q.y()) + " " + number(q.z()) +
                 " " + number(q.w()) + "\n";
@@ -362,11 +365,20 @@ void writeTumTrajectory(Context& context, const fs::path& path) {
 std::string framesReadme(const Context& context, const std::string& layout,
                          const std::string& truth) {
   const auto& info = context.calibration.info;
-  return "# " + sourceLine(context) + "\n\n" + layout +
-         "\n\n## Frames and units\n\n"
-         "- World: nadir's local NED at the scenario's origin (x north, y east, z down), metres.\n"
-         "- Body: FRD (x forward, y right, z down); the IMU is mounted on it, aligned, at its "
-         "origin.\n"
+  const bool enu = context.options.axes == core::Axes::kEnu;
+  const Eigen::Isometry3d T_body_cam =
+      core::bodyToSensorIn(context.options.axes, context.calibration.T_body_cam);
+  const Eigen::Vector3d p_body_cam = T_body_cam.translation();
+  const Eigen::Quaterniond q_body_cam(T_body_cam.rotation());
+  return "# " + sourceLine(context) + "\n\n" + layout + "\n\n## Frames and units\n\n" +
+         (enu ? "- World: local ENU at the scenario's origin (x east, y north, z up: REP-103), "
+                "metres (nadir's own is NED: written with --frame enu).\n"
+                "- Body: FLU (x forward, y left, z up: REP-103); the IMU is mounted on it, "
+                "aligned, at its origin.\n"
+              : "- World: nadir's local NED at the scenario's origin (x north, y east, z down), "
+                "metres.\n"
+                "- Body: FRD (x forward, y right, z down); the IMU is mounted on it, aligned, at "
+                "its origin.\n") +
          "- Camera: OpenCV optical (x right, y down the image, z along the optical axis).\n"
          "- Quaternions are Hamilton.\n- " +
          truth +
@@ -378,11 +390,10 @@ std::string framesReadme(const Context& context, const std::string& layout,
          "- distortion coefficients (model " +
          std::to_string(static_cast<int>(info.distortion_model)) +
          ": 0 none, 1 radial-tangential k1 k2 p1 p2 [k3], 2 equidistant k1 k2 k3 k4): " +
-         listOf(info.distortion) + "\n- T_body_cam: camera at " + number(info.p_cam_in_body_m.x()) +
-         ", " + number(info.p_cam_in_body_m.y()) + ", " + number(info.p_cam_in_body_m.z()) +
+         listOf(info.distortion) + "\n- T_body_cam: camera at " + number(p_body_cam.x()) + ", " +
+         number(p_body_cam.y()) + ", " + number(p_body_cam.z()) +
          " m in the body frame, R_body_cam (w x y z) " +
-         listOf(
-             {info.q_body_cam.w(), info.q_body_cam.x(), info.q_body_cam.y(), info.q_body_cam.z()}) +
+         listOf({q_body_cam.w(), q_body_cam.x(), q_body_cam.y(), q_body_cam.z()}) +
          "\n\nCounts: " + plural(context.summary.images, "image") + ", " +
          plural(context.summary.poses, "ground-truth pose") + ", " +
          plural(context.summary.imu_samples, "IMU sample") + ".\n";
@@ -392,6 +403,10 @@ void writeEuroc(Context& context) {
   const fs::path mav = context.out / "mav0";
   const auto& info = context.calibration.info;
   auto& notes = context.summary.notes;
+  const core::Axes axes = context.options.axes;
+  const bool enu = axes == core::Axes::kEnu;
+  const std::string body = enu ? "FLU" : "FRD";
+  const std::string world = enu ? "local ENU" : "local NED";
 
   // cam0
   {
@@ -412,9 +427,9 @@ void writeEuroc(Context& context) {
               "# " + sourceLine(context) +
                   "\n# General sensor definitions.\nsensor_type: camera\ncomment: nadir camera '" +
                   info.camera_name + "' on " + context.options.camera_channel +
-                  "\n\n# Sensor extrinsics wrt. the body-frame: T_body_cam, body FRD (= imu0), "
-                  "camera OpenCV optical.\nT_BS:\n" +
-                  yamlMatrix(context.calibration.T_body_cam, "  ") +
+                  "\n\n# Sensor extrinsics wrt. the body-frame: T_body_cam, body " + body +
+                  " (= imu0), camera OpenCV optical.\nT_BS:\n" +
+                  yamlMatrix(core::bodyToSensorIn(axes, context.calibration.T_body_cam), "  ") +
                   "\n# Camera specific definitions.\nrate_hz: " + number(cameraRateHz(context)) +
                   "\nresolution: [" + std::to_string(info.width) + ", " +
                   std::to_string(info.height) + "]\ncamera_model: pinhole\nintrinsics: [" +
@@ -430,8 +445,8 @@ void writeEuroc(Context& context) {
     csv << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
            "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
     for (const msg::Imu& s : context.scan.imu) {
-      const Eigen::Vector3d& w = s.angular_velocity_rps;
-      const Eigen::Vector3d& a = s.linear_acceleration_mps2;
+      const Eigen::Vector3d w = core::bodyVectorIn(axes, s.angular_velocity_rps);
+      const Eigen::Vector3d a = core::bodyVectorIn(axes, s.linear_acceleration_mps2);
       csv << nanosecondsText(s.utime) + "," + number(w.x()) + "," + number(w.y()) + "," +
                  number(w.z()) + "," + number(a.x()) + "," + number(a.y()) + "," + number(a.z()) +
                  "\n";
@@ -440,8 +455,10 @@ void writeEuroc(Context& context) {
     csv.close();
     writeText(mav / "imu0" / "sensor.yaml",
               "# " + sourceLine(context) + ", IMU from " + context.options.imu_channel +
-                  "\n#Default imu sensor yaml file\nsensor_type: imu\ncomment: nadir IMU, body "
-                  "FRD, specific force (a level vehicle at rest reads 0, 0, -9.81)\n\n"
+                  "\n#Default imu sensor yaml file\nsensor_type: imu\ncomment: nadir IMU, body " +
+                  body + ", specific force (a level vehicle at rest reads 0, 0, " +
+                  (enu ? "9.81" : "-9.81") +
+                  ")\n\n"
                   "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" +
                   yamlMatrix(Eigen::Isometry3d::Identity(), "  ") +
                   "rate_hz: " + number(medianRateHz(context.scan.imu)) +
@@ -462,26 +479,32 @@ void writeEuroc(Context& context) {
            "b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
            "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
     for (const msg::Pose& s : context.scan.truth) {
-      const Eigen::Quaterniond& q = s.q_world_body;
-      csv << nanosecondsText(s.utime) + "," + number(s.p_ned_m.x()) + "," + number(s.p_ned_m.y()) +
-                 "," + number(s.p_ned_m.z()) + "," + number(q.w()) + "," + number(q.x()) + "," +
-                 number(q.y()) + "," + number(q.z()) + "," + number(s.v_ned_mps.x()) + "," +
-                 number(s.v_ned_mps.y()) + "," + number(s.v_ned_mps.z()) + ",0,0,0,0,0,0\n";
+      const Eigen::Vector3d p = core::worldVectorIn(axes, s.p_ned_m);
+      const Eigen::Quaterniond q = core::attitudeIn(axes, s.q_world_body, core::BodyAxes::kVehicle);
+      const Eigen::Vector3d v = core::worldVectorIn(axes, s.v_ned_mps);
+      csv << nanosecondsText(s.utime) + "," + number(p.x()) + "," + number(p.y()) + "," +
+                 number(p.z()) + "," + number(q.w()) + "," + number(q.x()) + "," + number(q.y()) +
+                 "," + number(q.z()) + "," + number(v.x()) + "," + number(v.y()) + "," +
+                 number(v.z()) + ",0,0,0,0,0,0\n";
       ++context.summary.poses;
     }
     csv.close();
     writeText(mav / "state_groundtruth_estimate0" / "sensor.yaml",
               "# " + sourceLine(context) + ", truth from " + context.options.truth_channel +
-                  "\nsensor_type: visual-inertial\ncomment: nadir simulator truth: the body "
-                  "(FRD, = imu0) in the world (local NED); biases are not logged and are "
-                  "written as 0\n\n# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" +
+                  "\nsensor_type: visual-inertial\ncomment: nadir simulator truth: the body (" +
+                  body + ", = imu0) in the world (" + world +
+                  "); biases are not logged and are written as 0\n\n# Sensor extrinsics wrt. the "
+                  "body-frame.\nT_BS:\n" +
                   yamlMatrix(Eigen::Isometry3d::Identity(), "  "));
   }
 
-  writeText(mav / "body.yaml",
-            "# " + sourceLine(context) +
-                "\ncomment: the body frame is nadir's FRD body frame (x forward, y right, z down), "
-                "which is also the IMU frame (imu0)\n");
+  writeText(
+      mav / "body.yaml",
+      "# " + sourceLine(context) +
+          (enu ? "\ncomment: the body frame is FLU (x forward, y left, z up: REP-103; nadir's "
+                 "FRD body turned about x), which is also the IMU frame (imu0)\n"
+               : "\ncomment: the body frame is nadir's FRD body frame (x forward, y right, z "
+                 "down), which is also the IMU frame (imu0)\n"));
 
   // One timestamp per line, as ORB-SLAM3's EuRoC examples take them.
   {
@@ -490,26 +513,29 @@ void writeEuroc(Context& context) {
     times.close();
   }
 
-  writeText(context.out / "README.md",
-            framesReadme(
-                context,
-                "EuRoC MAV (ASL) layout:\n\n"
-                "```\nmav0/cam0/data/<timestamp_ns>.png   images\n"
-                "mav0/cam0/data.csv                  #timestamp [ns],filename\n"
-                "mav0/cam0/sensor.yaml               T_BS (= T_body_cam), rate_hz, resolution, "
-                "intrinsics, distortion\n"
-                "mav0/imu0/data.csv                  timestamp [ns], gyro (rad/s), specific force "
-                "(m/s^2), body FRD\n"
-                "mav0/state_groundtruth_estimate0/data.csv   timestamp [ns], p, q (w x y z), v, "
-                "b_w, b_a\n"
-                "timestamps.txt                      image timestamps [ns], one a line "
-                "(ORB-SLAM3's EuRoC_TimeStamps)\n```\n\n"
-                "Timestamps are the messages' utime in nanoseconds (utime * 1000): sim time, "
-                "from 0 at the start of a simulated run.",
-                "Ground truth (state_groundtruth_estimate0) is the body, T_world_body, at the "
-                "truth rate; velocity in the world frame; biases are not logged and are 0. "
-                "The body frame is the IMU frame (imu0's T_BS is the identity) and cam0's T_BS "
-                "is T_body_cam."));
+  writeText(
+      context.out / "README.md",
+      framesReadme(
+          context,
+          "EuRoC MAV (ASL) layout:\n\n"
+          "```\nmav0/cam0/data/<timestamp_ns>.png   images\n"
+          "mav0/cam0/data.csv                  #timestamp [ns],filename\n"
+          "mav0/cam0/sensor.yaml               T_BS (= T_body_cam), rate_hz, resolution, "
+          "intrinsics, distortion\n"
+          "mav0/imu0/data.csv                  timestamp [ns], gyro (rad/s), specific force "
+          "(m/s^2), body " +
+              body +
+              "\n"
+              "mav0/state_groundtruth_estimate0/data.csv   timestamp [ns], p, q (w x y z), v, "
+              "b_w, b_a\n"
+              "timestamps.txt                      image timestamps [ns], one a line "
+              "(ORB-SLAM3's EuRoC_TimeStamps)\n```\n\n"
+              "Timestamps are the messages' utime in nanoseconds (utime * 1000): sim time, "
+              "from 0 at the start of a simulated run.",
+          "Ground truth (state_groundtruth_estimate0) is the body, T_world_body, at the "
+          "truth rate; velocity in the world frame; biases are not logged and are 0. "
+          "The body frame is the IMU frame (imu0's T_BS is the identity) and cam0's T_BS "
+          "is T_body_cam."));
 }
 
 std::string dsoCalibration(const Context& context) {

@@ -3,17 +3,19 @@
 // EuRoC (ORB-SLAM3, OpenVINS, Basalt, Kimera), the TUM monocular layout (DSO)
 // and the TUM RGB-D layout (rgb.txt + groundtruth.txt, evo's "tum" format).
 //
-// Frames (docs/export.md): positions and orientations stay in nadir's world,
-// local NED. EuRoC's ground truth is the body (FRD, which is also the IMU
-// frame) at the truth rate, with T_BS of cam0 = T_body_cam; the TUM forms'
-// ground truth is the camera (OpenCV optical frame), T_world_cam, interpolated
-// at the image times (linear position, SLERP orientation).
+// Frames (docs/export.md): positions and orientations in nadir's world, local
+// NED with the body FRD, or in REP-103's ENU with the body FLU. EuRoC's ground truth is the body
+// (FRD, which is also the IMU frame) at the truth rate, with T_BS of cam0 = T_body_cam; the TUM
+// forms' ground truth is the camera (OpenCV optical frame), T_world_cam, interpolated at the image
+// times (linear position, SLERP orientation).
 
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "core/axes.h"
 
 namespace nadir::dataset {
 
@@ -35,6 +37,9 @@ struct ExportOptions {
   std::string info_channel;  // camera_info_t; empty = camera_channel + "_INFO"
   std::string truth_channel = "POSE_TRUTH";
   std::string imu_channel = "IMU";
+  // The axes of every pose, vector and extrinsic written: nadir's (world NED,
+  // body FRD) or REP-103's (world ENU, body FLU; core/axes.h).
+  core::Axes axes = core::Axes::kNed;
   // Called after each image written, with the count so far and the number of
   // image_t on the camera channel; may be empty.
   std::function<void(std::int64_t written, std::int64_t total)> progress;

@@ -1,6 +1,7 @@
 // nadir export: a synthetic run.lcmlog with known pixels, calibration, truth and
 // IMU is exported in each format and the folders are read back.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "core/bus.h"
 #include "core/frames.h"
 #include "core/lcm_log.h"
+#include "core/trajectory.h"
 #include "logs/export/export.h"
 #include "nadir/camera_info_t.hpp"
 #include "nadir/image_t.hpp"
@@ -403,6 +405,87 @@ TEST_F(ExportTest, TumWritesRgbListCalibrationAndCameraTruth) {
   std::erase_if(calibration, [](const std::string& line) { return line.starts_with("#"); });
   EXPECT_EQ(calibration,
             (std::vector<std::string>{"50 51 31.5 23.5 0.01 -0.002 0.0005 -0.0003 0"}));
+}
+
+// REP-103's axes, written out by hand: R_enu_ned swaps north and east and turns
+// down into up; R_frd_flu turns left into right and up into down.
+Eigen::Matrix3d enuFromNed() {
+  Eigen::Matrix3d R;
+  R << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  return R;
+}
+Eigen::Matrix3d frdFromFlu() { return Eigen::Vector3d(1, -1, -1).asDiagonal(); }
+
+// --frame enu: EuRoC's truth is the FLU body in ENU (position, attitude and
+// velocity), its IMU is in FLU (a level IMU's specific force +9.81 up), cam0's
+// T_BS is T_flu_cam; the TUM truth is the camera in ENU, says so in its frame
+// line and reads back in nadir's axes.
+TEST_F(ExportTest, EnuAxesTurnEveryPoseVectorAndExtrinsic) {
+  writeRun(log_);
+  ExportOptions options;
+  options.log_path = log_.string();
+  options.out_dir = (root_ / "euroc_enu").string();
+  options.axes = core::Axes::kEnu;
+  exportRun(options);
+  const fs::path mav = root_ / "euroc_enu" / "mav0";
+  const std::vector<std::string> truth =
+      readLines(mav / "state_groundtruth_estimate0" / "data.csv");
+  ASSERT_EQ(truth.size(), static_cast<std::size_t>(kTruthSamples + 1));
+  for (int i : {0, 7, kTruthSamples - 1}) {
+    const std::vector<double> row = numbers(truth[static_cast<std::size_t>(i) + 1], ',');
+    ASSERT_EQ(row.size(), 17u);
+    const double t = i * kTruthPeriodUs * 1e-6;
+    const Eigen::Vector3d p_ned = truthPosition(t);
+    EXPECT_NEAR(row[1], p_ned.y(), 1e-9);
+    EXPECT_NEAR(row[2], p_ned.x(), 1e-9);
+    EXPECT_NEAR(row[3], -p_ned.z(), 1e-9);
+    const Eigen::Matrix3d R_enu_flu =
+        enuFromNed() * truthOrientation(t).toRotationMatrix() * frdFromFlu();
+    const Eigen::Quaterniond q(row[4], row[5], row[6], row[7]);  // w x y z
+    EXPECT_NEAR(q.angularDistance(Eigen::Quaterniond(R_enu_flu)), 0.0, 1e-9);
+    EXPECT_EQ(row[8], 2.0);   // east
+    EXPECT_EQ(row[9], 10.0);  // north
+    EXPECT_EQ(row[10], 1.0);  // up
+  }
+  const std::vector<double> imu3 = numbers(readLines(mav / "imu0" / "data.csv")[4], ',');
+  ASSERT_EQ(imu3.size(), 7u);
+  EXPECT_DOUBLE_EQ(imu3[3], -0.5);   // a yaw rate to the right is one to the left's minus
+  EXPECT_DOUBLE_EQ(imu3[4], 0.015);  // forward stays forward
+  EXPECT_DOUBLE_EQ(imu3[6], 9.81);   // the specific force points up
+  const std::string yaml = readText(mav / "cam0" / "sensor.yaml");
+  const std::size_t data_at = yaml.find("data: [");
+  ASSERT_NE(data_at, std::string::npos);
+  const std::vector<double> m =
+      numbers(yaml.substr(data_at + 7, yaml.find(']', data_at) - data_at - 7), ',');
+  ASSERT_EQ(m.size(), 16u);
+  Eigen::Matrix4d expected_T = Eigen::Matrix4d::Identity();
+  expected_T.topLeftCorner<3, 3>() = frdFromFlu().transpose() * bodyFromCamera().rotation();
+  expected_T.topRightCorner<3, 1>() = Eigen::Vector3d(0.1, 0.0, -0.05);
+  for (int i = 0; i < 16; ++i)
+    EXPECT_NEAR(m[static_cast<std::size_t>(i)], expected_T(i / 4, i % 4), 1e-12);
+
+  options.out_dir = (root_ / "tum_enu").string();
+  options.format = Format::kTum;
+  exportRun(options);
+  const fs::path groundtruth = root_ / "tum_enu" / "groundtruth.txt";
+  std::vector<std::string> lines = readLines(groundtruth);
+  EXPECT_NE(std::find(lines.begin(), lines.end(), "# frame: world=enu body=camera"), lines.end());
+  std::erase_if(lines, [](const std::string& line) { return line.starts_with("#"); });
+  ASSERT_EQ(lines.size(), static_cast<std::size_t>(kImages));
+  const std::vector<double> v = numbers(lines[2], ' ');
+  ASSERT_EQ(v.size(), 8u);
+  const Eigen::Isometry3d T_ned_cam =
+      truthPose(static_cast<double>(imageUtime(2)) * 1e-6) * bodyFromCamera();
+  EXPECT_NEAR(v[1], T_ned_cam.translation().y(), 1e-9);
+  EXPECT_NEAR(v[2], T_ned_cam.translation().x(), 1e-9);
+  EXPECT_NEAR(v[3], -T_ned_cam.translation().z(), 1e-9);
+  EXPECT_NEAR(Eigen::Quaterniond(v[7], v[4], v[5], v[6])
+                  .angularDistance(Eigen::Quaterniond(enuFromNed() * T_ned_cam.rotation())),
+              0.0, 1e-9);
+  const core::Trajectory read = core::readTum(groundtruth.string());
+  ASSERT_EQ(read.size(), static_cast<std::size_t>(kImages));
+  EXPECT_LT((read[2].p_ned_m - T_ned_cam.translation()).norm(), 1e-9);
+  EXPECT_LT(read[2].q_world_body.angularDistance(Eigen::Quaterniond(T_ned_cam.rotation())), 1e-9);
 }
 
 // RGB images keep their colours: red stays red in the PNG.
