@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.h"
 #include "core/frames.h"
 #include "core/params.h"
 #include "nodes/scenario.h"
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   app.add_option("scenario", scenario_name, "a built-in scenario or a YAML path")->required();
   app.add_option("--set", overrides, "override a scenario parameter: key=value (repeatable)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   try {
     const nadir::nodes::ScenarioParams scenario =
         nadir::nodes::loadScenario(scenario_name, overrides);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/bus.h"
+#include "core/command_line.h"
 
 namespace {
 
@@ -41,7 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--height", height)->check(CLI::PositiveNumber);
   app.add_option("--rate", rate_hz, "frames/s; 0 = back to back")->check(CLI::NonNegativeNumber);
   app.add_option("--url", url);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   auto bus = nadir::core::openBus(url);
   std::atomic<int> received{0};

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "bench/vo_replay.h"
+#include "core/command_line.h"
 #include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/nav/nav_node.h"
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
                  "leave out GPS fixes from this sim time on, s (-1: keep all)");
   app.add_option("--rounds", rounds, "time the filter this many times (the best is printed)")
       ->check(CLI::Range(1, 100));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   try {
     const nadir::bench::RunFolder folder = nadir::bench::openRunFolder(

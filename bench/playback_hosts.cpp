@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.h"
 #include "core/lcm_log.h"
 #include "logs/eval/run_metrics.h"
 #include "run/process.h"
@@ -87,7 +88,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--speed", speed, "play speed, x real time")->capture_default_str();
   app.add_option("--out", out_dir, "where the recordings go (default RUN_DIR/playback)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   if (out_dir.empty()) out_dir = (fs::path(run_dir) / "playback").string();
 

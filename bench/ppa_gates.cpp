@@ -17,6 +17,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/command_line.h"
 #include "nodes/ppa/gate_tracker.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
   int rounds = 20;
   app.add_option("--frames", frames, "frames along the approach")->check(CLI::Range(2, 100000));
   app.add_option("--rounds", rounds, "times each frame is tracked")->check(CLI::Range(1, 100000));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   using namespace nadir;
 
   // A gate 4.6 m ahead with a decoy either side, on the arena floor.

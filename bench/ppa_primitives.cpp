@@ -2,7 +2,7 @@
 // primitive (nodes/ppa/ppa_array.h), in ns per call, each timed over many
 // repetitions with std::chrono::steady_clock on one thread (best of 10 batches).
 //
-//   nadir-bench-ppa-primitives [seconds_per_case (default 0.2)]
+//   nadir-bench-ppa-primitives [SECONDS_PER_CASE (default 0.2)]
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "core/command_line.h"
 #include "nodes/ppa/ppa_array.h"
 
 namespace {
@@ -80,7 +81,13 @@ nadir::ppa::DigitalPlane texture(std::uint32_t seed) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1) g_seconds = std::max(0.01, std::atof(argv[1]));
+  CLI::App app{
+      "SCAMP-5 emulator primitives: ns per call of each on this host, one thread, best of 10 "
+      "batches"};
+  app.add_option("seconds", g_seconds, "time spent on each primitive, s")
+      ->check(CLI::Range(0.01, 600.0))
+      ->capture_default_str();
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> u(-100.0f, 100.0f);
   std::vector<float> plane_a(kN), plane_b(kN), plane_f(kN);

@@ -24,6 +24,7 @@
 #include "nodes/ppa/visual_odometry.h"
 // The synthetic scenes (shared with the ppa tests).
 #include "bench/ppa_scenes.h"
+#include "core/command_line.h"
 
 namespace {
 
@@ -73,7 +74,7 @@ int main(int argc, char** argv) {
   std::uint32_t seed = 1;
   app.add_option("--frames", frames, "frames to process")->check(CLI::Range(2, 100000));
   app.add_option("--seed", seed, "texture seed");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   namespace ppa = nadir::ppa;
   namespace scenes = nadir::ppa::test;

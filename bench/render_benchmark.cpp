@@ -19,6 +19,7 @@
 
 #include "core/bus.h"
 #include "core/clock.h"
+#include "core/command_line.h"
 #include "core/frames.h"
 #include "lcmtypes/codec.h"
 #include "render/camera_renderer.h"
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
   std::string frame_png;
   app.add_option("--frame-png", frame_png,
                  "write each camera's first frame here (the camera's name is appended)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   nadir::render::HeadlessGlContext context;
   nadir::terrain::ProceduralWorldParams world_params;

@@ -23,6 +23,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench/vo_replay.h"
+#include "core/command_line.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/scenario.h"
 #include "nodes/vo_direct/vo_direct_node.h"
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--debug-png", debug_png,
                  "write the debug image (points by inverse depth) nearest after --debug-at-s here");
   app.add_option("--debug-at-s", debug_at_s, "seconds from the first image, for --debug-png");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   cv::setNumThreads(threads);
 
   try {

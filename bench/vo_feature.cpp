@@ -30,6 +30,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench/vo_replay.h"
+#include "core/command_line.h"
 #include "core/trajectory.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/scenario.h"
@@ -109,7 +110,7 @@ int main(int argc, char** argv) {
   app.add_option("--drift-every-s", drift_every_s,
                  "print the map's tilt, heading and height error against the truth every this "
                  "many seconds (0: not)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   cv::setNumThreads(threads);
 
   try {

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "core/command_line.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"nadir: a distributed testbed for GNSS-denied navigation"};
@@ -25,7 +26,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error);
+    return nadir::core::exitAfter(app, error);
   } catch (const std::exception& error) {
     std::cerr << "nadir: error: " << error.what() << "\n";
     return 1;

@@ -27,6 +27,7 @@
 
 #include "calib/board.h"
 #include "calib/calibrate.h"
+#include "core/command_line.h"
 #include "gui/calib_sources.h"
 #include "gui/calib_window.h"
 #include "gui/camera_frames.h"
@@ -97,7 +98,7 @@ int main(int argc, char** argv) {
                      "with --live and --screenshot: calibrate after this many seconds at the most")
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   const bool is_virtual = virtual_option->count() > 0;
   if (is_virtual && scenario.empty()) scenario = "calibration";

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/bus.h"
+#include "core/command_line.h"
 #include "gui/live_feed.h"
 #include "gui/plot_window.h"
 #include "gui/plots.h"
@@ -100,7 +101,7 @@ int main(int argc, char** argv) {
   double wait_s = 0.5;
   app.add_option("--wait", wait_s, "seconds before --screenshot (with --live: of listening)")
       ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   if (!headless) {
     if (!out_dir.empty()) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/bus.h"
+#include "core/command_line.h"
 #include "gui/live_feed.h"
 #include "gui/run_data.h"
 #include "gui/screenshot.h"
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
   app.add_option("--until-truth-poses", until_truth_poses,
                  "with --live and --screenshot: take it once the live run holds this many truth "
                  "poses (--wait is then the most to wait)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   if (!live && paths.empty()) {
     std::fprintf(stderr, "nadir-viewer: give a run folder or log, or --live (see --help)\n");
     return 2;

@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "core/clock.h"
+#include "core/command_line.h"
 #include "lcmtypes/bus_io.h"
 #include "nodes/registry.h"
 #include "nodes/scenario.h"
@@ -113,7 +114,7 @@ int runNodeMain(int argc, char** argv, const char* node_name) {
                  "this process replaces one that died: a VO node's num_resets goes on from "
                  "here (nadir launch --restart sets it)")
       ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
   if (list) {
     listScenarios();
     return 0;
