@@ -9,6 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/frame_option.h"
+#include "cli/progress_line.h"
 #include "core/params.h"
 #include "logs/eval/metrics.h"
 #include "logs/eval/run_metrics.h"
@@ -46,8 +47,12 @@ void evaluateRun(const EvalCommandOptions& options) {
   if (!fs::exists(log)) throw eval::EvalError(log.string() + ": no such file or directory");
   const fs::path dir = log.has_parent_path() ? log.parent_path() : fs::path(".");
 
-  const eval::RunEvaluation run =
-      eval::evaluateRunLog(log.string(), dir.string(), options.eval, truthChannelOf(options, dir));
+  eval::RunEvaluation run;
+  {
+    ProgressLine progress("nadir eval: reading " + log.string());
+    run = eval::evaluateRunLog(log.string(), dir.string(), options.eval,
+                               truthChannelOf(options, dir), progress.reading());
+  }
   if (!run.recorded.damage.empty()) {
     std::cerr << "nadir eval: warning: " << log.string() << ": " << run.recorded.damage << "\n";
   }

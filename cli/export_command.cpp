@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli/frame_option.h"
+#include "cli/progress_line.h"
 #include "logs/export/export.h"
 
 namespace nadir::cli {
@@ -45,16 +46,16 @@ void runExport(const ExportCommandOptions& options) {
   export_options.truth_channel = options.truth;
   export_options.imu_channel = options.imu;
   export_options.axes = options.axes;
-  const bool terminal = isatty(fileno(stdout)) != 0;
-  export_options.progress = [terminal](std::int64_t written, std::int64_t total) {
-    if (terminal && (written % 50 == 0 || written == total)) {
-      std::cout << "\r  images: " << written << "/" << total << std::flush;
-    }
-  };
   std::cout << "nadir export: " << options.camera << " of " << export_options.log_path << " as "
-            << dataset::formatName(export_options.format) << "\n";
-  const dataset::ExportSummary summary = dataset::exportRun(export_options);
-  if (terminal) std::cout << "\n";
+            << dataset::formatName(export_options.format) << std::endl;
+  dataset::ExportSummary summary;
+  {
+    ProgressLine progress("nadir export");
+    export_options.progress = [&progress](std::int64_t written, std::int64_t total) {
+      progress.count(written, total, "images written");
+    };
+    summary = dataset::exportRun(export_options);
+  }
   std::cout << "  wrote " << summary.images << " images, " << summary.poses
             << " ground-truth poses, " << summary.imu_samples << " IMU samples to "
             << summary.out_dir << "\n";

@@ -1,5 +1,6 @@
 // nadir log info|cut|play|record: look into, cut, replay and record LCM logs (logs/).
 #include "cli/commands.h"
+#include "cli/progress_line.h"
 
 #include <CLI/CLI.hpp>
 
@@ -74,7 +75,12 @@ struct LogRecordCommandOptions {
 };
 
 void runLogInfo(const LogInfoCommandOptions& options) {
-  std::cout << logs::formatLogInfo(logs::logInfo(options.log));
+  logs::LogInfo info;
+  {
+    ProgressLine progress("nadir log info: reading " + options.log);
+    info = logs::logInfo(options.log, progress.reading());
+  }
+  std::cout << logs::formatLogInfo(info);
 }
 
 std::string seconds(double t_s) {
@@ -101,7 +107,12 @@ void runLogCut(const LogCutCommandOptions& options) {
       cut.end_s = options.end_s;
     }
   }
-  const logs::CutResult result = logs::cutLog(options.log, options.out, cut);
+  logs::CutResult result;
+  {
+    ProgressLine progress("nadir log cut: reading " + options.log);
+    cut.progress = progress.reading();
+    result = logs::cutLog(options.log, options.out, cut);
+  }
   std::cout << "nadir log cut: wrote " << result.events_written << " of " << result.events_read
             << " events (" << result.bytes_written << " bytes) to " << options.out << "\n";
   if (result.events_written > 0) {

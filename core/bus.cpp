@@ -74,6 +74,11 @@ Bus::Channel& Bus::channel(std::string_view name) {
 
 void Bus::publish(std::string_view channel, const void* data, std::size_t size,
                   std::int64_t event_utime) {
+  if (channel.empty() || channel.size() > kMaxChannelNameBytes) {
+    throw BusError("channel name '" + std::string(channel) + "' is " +
+                   std::to_string(channel.size()) + " bytes: LCM's channel names are 1 to " +
+                   std::to_string(kMaxChannelNameBytes) + " bytes");
+  }
   send(channel, data, size, event_utime);
   std::lock_guard lock(stats_mutex_);
   auto it = sent_.find(channel);

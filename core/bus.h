@@ -81,8 +81,13 @@ class Bus {
   // The URL this bus was opened with, after defaults were applied.
   virtual std::string url() const = 0;
 
+  // LCM's longest channel name, bytes (LCM_MAX_CHANNEL_NAME_LENGTH).
+  static constexpr std::size_t kMaxChannelNameBytes = 63;
+
   // Sends one encoded message and counts it. event_utime is the message's own
   // time; a log writer stores it as the event timestamp, live transports ignore it.
+  // Throws BusError for an empty channel name or one over kMaxChannelNameBytes
+  // (every transport: a log's channel would not go onto the network).
   void publish(std::string_view channel, const void* data, std::size_t size,
                std::int64_t event_utime);
 

@@ -50,6 +50,24 @@ LcmLogReader::~LcmLogReader() {
 }
 
 std::optional<LogEvent> LcmLogReader::next() {
+  std::optional<LogEvent> event = nextEvent();
+  if (progress_) {
+    const std::int64_t at = event ? tell() : file_size_;
+    if (!event || at >= progress_next_at_) {
+      progress_(at, file_size_);
+      progress_next_at_ = at + progress_every_;
+    }
+  }
+  return event;
+}
+
+void LcmLogReader::onProgress(ReadProgress progress, std::int64_t every_bytes) {
+  progress_ = std::move(progress);
+  progress_every_ = std::max<std::int64_t>(every_bytes, 1);
+  progress_next_at_ = tell() + progress_every_;
+}
+
+std::optional<LogEvent> LcmLogReader::nextEvent() {
   while (true) {
     const std::int64_t offset = std::ftell(file_);
     const std::int64_t remaining = file_size_ - offset;

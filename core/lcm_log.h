@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -40,6 +41,10 @@ struct LogDamage {
   std::int64_t bytes = 0;
 };
 
+// Told how far a reader has come: bytes read (the next event's offset) of the
+// file's size; once more at the end with both equal.
+using ReadProgress = std::function<void(std::int64_t bytes_read, std::int64_t file_bytes)>;
+
 class LcmLogReader {
  public:
   // Throws LogError if the file cannot be opened or does not start with an event.
@@ -53,6 +58,9 @@ class LcmLogReader {
   // whose length fields put the next event's start inside it); a truncated
   // last event ends the log and is reported by truncatedTailBytes().
   std::optional<LogEvent> next();
+  // Calls progress from next() each time another every_bytes have been read,
+  // and at the end.
+  void onProgress(ReadProgress progress, std::int64_t every_bytes = 64 << 20);
 
   const std::string& path() const { return path_; }
   std::int64_t eventsRead() const { return events_read_; }
@@ -77,6 +85,7 @@ class LcmLogReader {
   void seek(std::int64_t offset);
 
  private:
+  std::optional<LogEvent> nextEvent();
   bool resyncFrom(std::int64_t offset);
   std::int64_t findMagic(std::int64_t from, std::int64_t limit);
   bool followedByEvent(std::int64_t end);
@@ -90,6 +99,9 @@ class LcmLogReader {
   std::int64_t truncated_tail_bytes_ = 0;
   std::int64_t truncated_at_ = -1;
   std::vector<LogDamage> damage_;
+  ReadProgress progress_;
+  std::int64_t progress_every_ = 0;
+  std::int64_t progress_next_at_ = 0;
 };
 
 class LcmLogWriter {

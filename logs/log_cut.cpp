@@ -28,6 +28,7 @@ CutResult cutLog(const std::string& in, const std::string& out, const CutOptions
   }
 
   core::LcmLogReader reader(in);
+  if (options.progress) reader.onProgress(options.progress);
   core::LcmLogWriter writer(out);
   CutResult result;
   std::int64_t start_utime = std::numeric_limits<std::int64_t>::min();

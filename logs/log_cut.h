@@ -25,6 +25,8 @@ struct CutOptions {
   std::string channels;
   // ...and drop those matching this one (empty: none).
   std::string exclude;
+  // Told how far the reading of in has come; may be empty.
+  core::ReadProgress progress;
 };
 
 struct CutResult {

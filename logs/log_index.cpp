@@ -6,8 +6,9 @@
 
 namespace nadir::logs {
 
-LogIndex indexLog(const std::string& path) {
+LogIndex indexLog(const std::string& path, const core::ReadProgress& progress) {
   core::LcmLogReader reader(path);
+  if (progress) reader.onProgress(progress);
   LogIndex index;
   index.path = path;
   index.file_bytes = reader.fileSize();

@@ -39,6 +39,7 @@ struct LogIndex {
 // Reads the whole log once. A damaged or truncated log is indexed up to and
 // around the damage, which is reported in damage/damage_report. Throws
 // core::LogError if the file cannot be opened or is not a log.
-LogIndex indexLog(const std::string& path);
+// progress is told how far the reading has come (core::LcmLogReader::onProgress).
+LogIndex indexLog(const std::string& path, const core::ReadProgress& progress = {});
 
 }  // namespace nadir::logs

@@ -59,7 +59,9 @@ std::string table(const std::vector<std::vector<std::string>>& rows, const std::
 
 }  // namespace
 
-LogInfo logInfo(const std::string& path) { return logInfo(indexLog(path)); }
+LogInfo logInfo(const std::string& path, const core::ReadProgress& progress) {
+  return logInfo(indexLog(path, progress));
+}
 
 LogInfo logInfo(const LogIndex& index) {
   LogInfo info;

@@ -50,7 +50,7 @@ struct LogInfo {
 
 // Reads the log once; a damaged log is described up to and around the damage.
 // Throws core::LogError if the file cannot be opened or is not a log.
-LogInfo logInfo(const std::string& path);
+LogInfo logInfo(const std::string& path, const core::ReadProgress& progress = {});
 LogInfo logInfo(const LogIndex& index);
 
 // A readable summary: the spans, a table of channels, the damage.

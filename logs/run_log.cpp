@@ -126,12 +126,14 @@ LogTrajectories TrajectoryCollector::trajectories() const {
   return out;
 }
 
-LogTrajectories readRunLog(const std::string& log_path, const std::string& truth_channel) {
+LogTrajectories readRunLog(const std::string& log_path, const std::string& truth_channel,
+                           const core::ReadProgress& progress) {
   TrajectoryCollector collector(truth_channel);
   std::size_t events = 0;
   std::string reader_damage;
   try {
     core::LcmLogReader reader(log_path);
+    if (progress) reader.onProgress(progress);
     while (const std::optional<core::LogEvent> event = reader.next()) {
       ++events;
       collector.add(event->channel, event->data.data(), event->data.size());

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/lcm_log.h"
 #include "core/trajectory.h"
 
 namespace nadir::logs {
@@ -94,7 +95,9 @@ class TrajectoryCollector {
 // Reads a log's truth and estimates. A damaged log gives what could be read and
 // says what was wrong in `damage`. Throws RunLogError naming the log if it
 // cannot be opened, is empty, or holds no valid truth.
-LogTrajectories readRunLog(const std::string& log_path, const std::string& truth_channel = {});
+// progress is told how far the reading has come.
+LogTrajectories readRunLog(const std::string& log_path, const std::string& truth_channel = {},
+                           const core::ReadProgress& progress = {});
 
 // The TRACKING estimates as a trajectory, normalised, the first of equal stamps kept.
 core::Trajectory trackingTrajectory(const std::vector<SourceEstimate>& estimates);

@@ -548,9 +548,10 @@ RunMetrics evaluate(const core::Trajectory& truth,
 }
 
 RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
-                             const EvalOptions& options, const std::string& truth_channel) {
+                             const EvalOptions& options, const std::string& truth_channel,
+                             const core::ReadProgress& progress) {
   RunEvaluation run;
-  run.recorded = logs::readRunLog(log_path, truth_channel);
+  run.recorded = logs::readRunLog(log_path, truth_channel, progress);
   run.metrics = evaluate(run.recorded.truth, run.recorded.sources, options, run.recorded.filters);
   if (!run.recorded.waypoints.empty()) {
     run.metrics.guidance = evaluateGuidance(

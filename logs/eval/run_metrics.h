@@ -117,8 +117,10 @@ struct RunEvaluation {
 
 // Reads log_path (truth_channel as logs::readRunLog takes it), evaluates every
 // source and writes metrics.json, truth.tum and <source>.tum into out_dir.
+// progress is told how far the reading of the log has come.
 RunEvaluation evaluateRunLog(const std::string& log_path, const std::string& out_dir,
-                             const EvalOptions& options, const std::string& truth_channel = {});
+                             const EvalOptions& options, const std::string& truth_channel = {},
+                             const core::ReadProgress& progress = {});
 
 // metrics.json (schema in docs/evaluation.md); NaN is written as null and read
 // back as NaN. Both throw EvalError naming the file.

@@ -63,6 +63,28 @@ TEST(Bus, MemqRoundTrip) {
   EXPECT_FALSE(bus->handle(milliseconds(0)));
 }
 
+// LCM's channel names are 1 to 63 bytes: 63 are sent, 64 or none are refused
+// on every transport with the name and the limit, and nothing is counted sent.
+TEST(Bus, ChannelNamesOverLcmsLimitAreRefused) {
+  for (const char* url : {"memq://", "udpm://239.255.76.67:7893?ttl=0"}) {
+    auto bus = openBus(url);
+    const std::string longest(63, 'C');
+    publish(*bus, longest, makePose(1000, 1.5));
+    const std::string too_long(64, 'C');
+    try {
+      publish(*bus, too_long, makePose(1000, 1.5));
+      ADD_FAILURE() << url << ": a 64-byte channel name was sent";
+    } catch (const BusError& error) {
+      EXPECT_NE(std::string(error.what()).find("is 64 bytes: LCM's channel names are 1 to 63"),
+                std::string::npos)
+          << error.what();
+    }
+    EXPECT_THROW(publish(*bus, "", makePose(1000, 1.5)), BusError);
+    EXPECT_EQ(bus->sent().count(too_long), 0u) << url;
+    EXPECT_EQ(bus->sent().at(longest), 1) << url;
+  }
+}
+
 // Channel patterns are regexes matched against the whole channel name, as in LCM.
 TEST(Bus, ChannelRegexMatchesWholeNames) {
   auto bus = openBus("memq://");

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -108,6 +109,29 @@ TEST(LcmLog, NadirReadsWhatLcmEventlogWrites) {
 }
 
 // The first event's header bytes are the format's, worked out by hand.
+// A reader told to report every 1000 bytes: 10 events of 28 + 3 + 200 = 231 bytes
+// (2310 in all) report at the end of events 5 (1155 bytes, the first past 1000)
+// and 10 (2310, past 2155), then once more at the end, with the file's size.
+TEST(LcmLog, ProgressIsToldEveryStretchOfBytesAndAtTheEnd) {
+  const std::string path = tempPath("progress.lcmlog");
+  {
+    LcmLogWriter writer(path);
+    const std::vector<std::uint8_t> data(200, 7);
+    for (int i = 0; i < 10; ++i) writer.write(i, "CHN", data.data(), data.size());
+  }
+  LcmLogReader reader(path);
+  ASSERT_EQ(reader.fileSize(), 2310);
+  std::vector<std::pair<std::int64_t, std::int64_t>> told;
+  reader.onProgress([&](std::int64_t done, std::int64_t total) { told.emplace_back(done, total); },
+                    1000);
+  int events = 0;
+  while (reader.next()) ++events;
+  EXPECT_EQ(events, 10);
+  const std::vector<std::pair<std::int64_t, std::int64_t>> expected = {
+      {1155, 2310}, {2310, 2310}, {2310, 2310}};
+  EXPECT_EQ(told, expected);
+}
+
 TEST(LcmLog, HeaderBytesAreBigEndian) {
   const std::string path = tempPath("header.lcmlog");
   {
