@@ -13,6 +13,7 @@
 #include <system_error>
 #include <utility>
 
+#include "core/csv.h"
 #include "core/frames.h"
 
 namespace nadir::gui {
@@ -371,7 +372,7 @@ RunData runFromPoses(const std::string& name, const logs::LogTrajectories& recor
 std::string resultsCsv(const eval::RunMetrics& metrics) {
   std::string out = "source,position_rmse_m,rotation_rmse_deg,tracked_pct,ape_rmse_m,rpe_rmse_m\n";
   for (const auto& [name, m] : metrics.sources) {
-    out += name;
+    out += core::csvField(name);
     for (const double value : {m.position_rmse_m, m.rotation_rmse_deg, m.tracked_pct,
                                m.ape_translation_m.rmse, m.rpe_translation_m.rmse}) {
       out += ',';
@@ -407,7 +408,7 @@ std::string figureDataCsv(const RunData& run, const std::string& figure,
     if (hidden.contains(name)) return;
     for (std::size_t i = 0; i < pose.size(); ++i) {
       if (error != nullptr ? !std::isfinite((*error)[i]) : !std::isfinite(pose.x_m[i])) continue;
-      out += name;
+      out += core::csvField(name);
       out += ',';
       appendNumber(out, pose.t_s[i] - run.t0_s);
       if (error != nullptr) {

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/csv.h"
 #include "core/params.h"
 #include "run/process.h"
 #include "run/yaml_file.h"
@@ -519,7 +520,7 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
   const bool course = anyCourse(cells);
   const bool guidance = anyGuidance(cells);
   std::string csv;
-  for (const SweepAxis& axis : spec.axes) csv += axis.key + ",";
+  for (const SweepAxis& axis : spec.axes) csv += core::csvField(axis.key) + ",";
   csv += "run,truth_track_length_m";
   // A filter's own figures, for the sources that are filters in some cell.
   std::set<std::string> filters;
@@ -529,12 +530,12 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
       if (metrics.filter) filters.insert(name);
   }
   for (const std::string& source : sources) {
-    csv += "," + source + ".position_rmse_m," + source + ".rotation_rmse_deg," + source +
-           ".tracked_pct," + source + ".resets";
+    for (const char* column : {".position_rmse_m", ".rotation_rmse_deg", ".tracked_pct", ".resets"})
+      csv += "," + core::csvField(source + column);
     if (filters.contains(source)) {
       for (const char* column : {".error_denial_60_m", ".error_denial_120_m", ".error_end_m",
                                  ".nees_position_mean", ".nees_attitude_mean"})
-        csv += "," + source + column;
+        csv += "," + core::csvField(source + column);
     }
   }
   if (course) {
@@ -545,7 +546,7 @@ std::string sweepCsv(const SweepSpec& spec, const std::vector<SweepCell>& cells)
   }
   csv += "\n";
   for (const SweepCell& cell : cells) {
-    for (const std::string& value : cell.values) csv += value + ",";
+    for (const std::string& value : cell.values) csv += core::csvField(value) + ",";
     csv += cell.metrics ? "ok," + number(cell.metrics->truth_track_length_m) : "failed,";
     for (const std::string& source : sources) {
       const eval::SourceMetrics* metrics = sourceOf(cell, source);

@@ -199,7 +199,7 @@ ImageryRaster readImageWithBounds(const std::string& path, const LatLonBounds& b
   }
   cv::Mat bgr;
   try {
-    bgr = cv::imread(path, cv::IMREAD_COLOR);
+    bgr = cv::imread(path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
     throw TerrainError(path + ": OpenCV cannot decode it: " + e.what());
   }

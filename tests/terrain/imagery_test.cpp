@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -180,6 +181,38 @@ TEST(PlainImage, CornersGiveGeoreferenceAndNorthIsUp) {
   EXPECT_THROW(
       readImageWithBounds(path, {.north_deg = 46, .south_deg = 47, .west_deg = 7, .east_deg = 8}),
       TerrainError);
+}
+
+// A JPEG whose EXIF says "rotate 90 deg to view" (orientation 6): imagery given
+// by its corners is the pixels as stored, north up, never turned. The APP1
+// segment: "Exif", a little-endian TIFF header and one IFD entry, tag 0x0112
+// (orientation), SHORT, 1 value, 6.
+TEST(PlainImage, AnExifOrientationDoesNotTurnTheImagery) {
+  cv::Mat bgr(20, 40, CV_8UC3, cv::Scalar(255, 0, 0));
+  bgr(cv::Rect(0, 0, 40, 10)).setTo(cv::Scalar(0, 0, 255));  // red north half
+  std::vector<std::uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", bgr, jpeg));
+  const std::vector<std::uint8_t> app1 = {0xFF, 0xE1, 0x00, 0x22, 'E',  'x',  'i',  'f',  0,
+                                          0,    'I',  'I',  0x2A, 0x00, 0x08, 0x00, 0x00, 0x00,
+                                          0x01, 0x00, 0x12, 0x01, 0x03, 0x00, 0x01, 0x00, 0x00,
+                                          0x00, 0x06, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00};
+  jpeg.insert(jpeg.begin() + 2, app1.begin(), app1.end());
+  const std::string path = tempPath("exif_rotated.jpg");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(jpeg.data()),
+              static_cast<std::streamsize>(jpeg.size()));
+  }
+  // OpenCV's default read turns it, which shows the EXIF is read.
+  ASSERT_EQ(cv::imread(path, cv::IMREAD_COLOR).cols, 20);
+  const ImageryRaster imagery = readImageWithBounds(
+      path, {.north_deg = 47.0, .south_deg = 46.0, .west_deg = 7.0, .east_deg = 8.0});
+  EXPECT_EQ(imagery.rgb.cols, 40);
+  EXPECT_EQ(imagery.rgb.rows, 20);
+  const auto north = imagery.colourAt(core::geodeticFromDegrees(46.8, 7.5, 0.0));
+  ASSERT_TRUE(north);
+  EXPECT_GT((*north)[0], 200);  // red, within JPEG's loss
+  EXPECT_LT((*north)[2], 60);
 }
 
 TEST(ImageryRaster, NearestAndBilinearColour) {
