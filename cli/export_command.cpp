@@ -13,7 +13,9 @@
 
 #include "cli/frame_option.h"
 #include "cli/progress_line.h"
+#include "core/params.h"
 #include "logs/export/export.h"
+#include "nodes/sim/sim_params.h"
 
 namespace nadir::cli {
 namespace {
@@ -46,6 +48,18 @@ void runExport(const ExportCommandOptions& options) {
   export_options.truth_channel = options.truth;
   export_options.imu_channel = options.imu;
   export_options.axes = options.axes;
+  // The IMU's noise is the run's scenario's (a log does not carry it).
+  if (const fs::path scenario = run_dir / "scenario.yaml"; fs::is_regular_file(scenario)) {
+    sim::SimParams sim;
+    core::applyYamlFileKeys(scenario.string(), {"sensors"},
+                            [&sim](core::ParamVisitor& v) { sim.visit(v); });
+    const sim::ImuParams& imu = sim.sensors.imu.model;
+    export_options.imu_noise =
+        dataset::ImuNoise{.gyroscope_noise_density = imu.gyro_noise_density_rps_rthz,
+                          .gyroscope_random_walk = imu.gyro_bias_random_walk_rps_rts,
+                          .accelerometer_noise_density = imu.accel_noise_density_mps2_rthz,
+                          .accelerometer_random_walk = imu.accel_bias_random_walk_mps2_rts};
+  }
   std::cout << "nadir export: " << options.camera << " of " << export_options.log_path << " as "
             << dataset::formatName(export_options.format) << std::endl;
   dataset::ExportSummary summary;

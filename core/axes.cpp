@@ -42,6 +42,8 @@ Eigen::Quaterniond attitudeIn(Axes axes, const Eigen::Quaterniond& q_ned_body, B
   if (axes == Axes::kNed) return q_ned_body;
   Eigen::Quaterniond q = kQ_enu_ned * q_ned_body;
   if (body == BodyAxes::kVehicle) q = q * kQ_frd_flu;
+  // w >= 0: the same rotation, as most writers of REP-103 files give it.
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
   return q.normalized();
 }
 

@@ -160,7 +160,8 @@ Scan scanLog(const ExportOptions& options, const std::string& info_channel) {
 
 std::string number(double value) {
   char text[64];
-  std::snprintf(text, sizeof(text), "%.12g", value);
+  // + 0.0 writes a negative zero (an axis turned from 0) as 0.
+  std::snprintf(text, sizeof(text), "%.12g", value + 0.0);
   return text;
 }
 
@@ -399,6 +400,79 @@ std::string framesReadme(const Context& context, const std::string& layout,
          plural(context.summary.imu_samples, "IMU sample") + ".\n";
 }
 
+// EuRoC's (and Kalibr's) noise lines of an IMU's sensor.yaml.
+std::string imuNoiseYaml(const std::optional<ImuNoise>& noise) {
+  if (!noise) {
+    return "# The noise densities and random walks are the scenario's sensors.imu parameters; "
+           "no scenario.yaml was beside the log.\n";
+  }
+  return "# The scenario's sensors.imu, continuous time.\ngyroscope_noise_density: " +
+         number(noise->gyroscope_noise_density) +
+         "     # [ rad / s / sqrt(Hz) ]\ngyroscope_random_walk: " +
+         number(noise->gyroscope_random_walk) +
+         "       # [ rad / s^2 / sqrt(Hz) ]\naccelerometer_noise_density: " +
+         number(noise->accelerometer_noise_density) +
+         "  # [ m / s^2 / sqrt(Hz) ]\naccelerometer_random_walk: " +
+         number(noise->accelerometer_random_walk) + "    # [ m / s^3 / sqrt(Hz) ]\n";
+}
+
+// ORB-SLAM3's settings (file version 1.0) for this camera and IMU: monocular-
+// inertial when the IMU's noise is known, monocular otherwise. The ORB
+// extractor's figures are ORB-SLAM3's EuRoC ones, its feature count scaled with
+// the image area from EuRoC's 752 x 480 (1000 features), 1000 to 3000.
+std::string orbSlam3Settings(const Context& context) {
+  const auto& info = context.calibration.info;
+  const bool fisheye = info.distortion_model == msg::Distortion::EQUIDISTANT;
+  std::vector<std::string> unused;
+  const std::vector<double> k = firstCoefficients(info, 4, "ORB-SLAM3", unused);
+  std::string text = "%YAML:1.0\n# " + sourceLine(context) +
+                     "\n# ORB-SLAM3 (v1.0 settings): ./Examples/" +
+                     (context.options.imu_noise ? "Monocular-Inertial/mono_inertial_euroc"
+                                                : "Monocular/mono_euroc") +
+                     " ORBvoc.txt orbslam3.yaml . timestamps.txt\n\nFile.version: \"1.0\"\n\n"
+                     "Camera.type: \"" +
+                     (fisheye ? "KannalaBrandt8" : "PinHole") + "\"\n";
+  text += "Camera1.fx: " + number(info.fx) + "\nCamera1.fy: " + number(info.fy) +
+          "\nCamera1.cx: " + number(info.cx) + "\nCamera1.cy: " + number(info.cy) + "\n";
+  const char* names[4] = {"k1", "k2", fisheye ? "k3" : "p1", fisheye ? "k4" : "p2"};
+  for (int i = 0; i < 4; ++i) {
+    text +=
+        std::string("Camera1.") + names[i] + ": " + number(k[static_cast<std::size_t>(i)]) + "\n";
+  }
+  if (!fisheye && info.distortion.size() > 4 && info.distortion[4] != 0.0) {
+    text += "Camera1.k3: " + number(info.distortion[4]) + "\n";
+  }
+  const double features = std::clamp(
+      1000.0 * static_cast<double>(info.width) * info.height / (752.0 * 480.0), 1000.0, 3000.0);
+  text += "Camera.width: " + std::to_string(info.width) +
+          "\nCamera.height: " + std::to_string(info.height) +
+          "\nCamera.fps: " + number(std::round(cameraRateHz(context))) + "\nCamera.RGB: 1\n\n";
+  if (const auto& noise = context.options.imu_noise) {
+    const Eigen::Matrix4d T =
+        core::bodyToSensorIn(context.options.axes, context.calibration.T_body_cam).matrix();
+    text +=
+        "# T_b_c1: the camera in the body (= IMU) frame\nIMU.T_b_c1: !!opencv-matrix\n"
+        "  rows: 4\n  cols: 4\n  dt: f\n  data: [";
+    for (int i = 0; i < 16; ++i) {
+      const double value = std::abs(T(i / 4, i % 4)) < 1e-12 ? 0.0 : T(i / 4, i % 4);
+      text += (i > 0 ? ", " : "") + number(value);
+    }
+    text += "]\nIMU.NoiseGyro: " + number(noise->gyroscope_noise_density) +
+            "\nIMU.NoiseAcc: " + number(noise->accelerometer_noise_density) +
+            "\nIMU.GyroWalk: " + number(noise->gyroscope_random_walk) +
+            "\nIMU.AccWalk: " + number(noise->accelerometer_random_walk) +
+            "\nIMU.Frequency: " + number(std::round(medianRateHz(context.scan.imu))) + "\n\n";
+  }
+  text += "ORBextractor.nFeatures: " + std::to_string(static_cast<int>(std::round(features))) +
+          "\nORBextractor.scaleFactor: 1.2\nORBextractor.nLevels: 8\n"
+          "ORBextractor.iniThFAST: 20\nORBextractor.minThFAST: 7\n\n"
+          "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1.0\nViewer.GraphLineWidth: 0.9\n"
+          "Viewer.PointSize: 2.0\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3.0\n"
+          "Viewer.ViewpointX: 0.0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -3.5\n"
+          "Viewer.ViewpointF: 500.0\n";
+  return text;
+}
+
 void writeEuroc(Context& context) {
   const fs::path mav = context.out / "mav0";
   const auto& info = context.calibration.info;
@@ -461,9 +535,8 @@ void writeEuroc(Context& context) {
                   ")\n\n"
                   "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" +
                   yamlMatrix(Eigen::Isometry3d::Identity(), "  ") +
-                  "rate_hz: " + number(medianRateHz(context.scan.imu)) +
-                  "\n\n# The noise densities and random walks are the scenario's sensors.imu "
-                  "parameters; the log does not carry them.\n");
+                  "rate_hz: " + number(medianRateHz(context.scan.imu)) + "\n\n" +
+                  imuNoiseYaml(context.options.imu_noise));
     if (context.scan.imu.empty()) {
       notes.push_back("no imu_t on " + context.options.imu_channel +
                       ": mav0/imu0/data.csv has only its header");
@@ -505,6 +578,13 @@ void writeEuroc(Context& context) {
                  "FRD body turned about x), which is also the IMU frame (imu0)\n"
                : "\ncomment: the body frame is nadir's FRD body frame (x forward, y right, z "
                  "down), which is also the IMU frame (imu0)\n"));
+
+  writeText(context.out / "orbslam3.yaml", orbSlam3Settings(context));
+  if (!context.options.imu_noise) {
+    notes.push_back(
+        "the IMU's noise is not known (no scenario.yaml beside the log): orbslam3.yaml is "
+        "monocular only and imu0/sensor.yaml has no noise figures");
+  }
 
   // One timestamp per line, as ORB-SLAM3's EuRoC examples take them.
   {

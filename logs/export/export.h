@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +30,15 @@ enum class Format {
 Format parseFormat(const std::string& name);
 std::string formatName(Format format);
 
+// An IMU's white noise and bias random walk, continuous time, as EuRoC's and
+// Kalibr's sensor files give them.
+struct ImuNoise {
+  double gyroscope_noise_density = 0;      // rad/s/sqrt(Hz)
+  double gyroscope_random_walk = 0;        // rad/s^2/sqrt(Hz)
+  double accelerometer_noise_density = 0;  // m/s^2/sqrt(Hz)
+  double accelerometer_random_walk = 0;    // m/s^3/sqrt(Hz)
+};
+
 struct ExportOptions {
   std::string log_path;  // an LCM log, for example RUN_DIR/run.lcmlog
   std::string out_dir;   // created; must not exist or be empty
@@ -40,6 +50,10 @@ struct ExportOptions {
   // The axes of every pose, vector and extrinsic written: nadir's (world NED,
   // body FRD) or REP-103's (world ENU, body FLU; core/axes.h).
   core::Axes axes = core::Axes::kNed;
+  // The IMU's noise as the run's scenario gave it (a log does not carry it):
+  // written into EuRoC's imu0/sensor.yaml and the ORB-SLAM3 settings; without
+  // it the settings are monocular only and a note says why.
+  std::optional<ImuNoise> imu_noise;
   // Called after each image written, with the count so far and the number of
   // image_t on the camera channel; may be empty.
   std::function<void(std::int64_t written, std::int64_t total)> progress;

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/bus.h"
@@ -486,6 +487,64 @@ TEST_F(ExportTest, EnuAxesTurnEveryPoseVectorAndExtrinsic) {
   ASSERT_EQ(read.size(), static_cast<std::size_t>(kImages));
   EXPECT_LT((read[2].p_ned_m - T_ned_cam.translation()).norm(), 1e-9);
   EXPECT_LT(read[2].q_world_body.angularDistance(Eigen::Quaterniond(T_ned_cam.rotation())), 1e-9);
+}
+
+// With the IMU's noise known (the run's scenario), EuRoC's imu0/sensor.yaml
+// carries it and orbslam3.yaml is monocular-inertial: read back with OpenCV's
+// FileStorage (what ORB-SLAM3 reads it with), its camera is the calibration,
+// its T_b_c1 is T_body_cam and its noise the scenario's. Without it the
+// settings are monocular and a note says why.
+TEST_F(ExportTest, EurocCarriesTheImuNoiseAndOrbSlam3Settings) {
+  writeRun(log_);
+  ExportOptions options;
+  options.log_path = log_.string();
+  options.out_dir = (root_ / "euroc_noise").string();
+  options.imu_noise = ImuNoise{.gyroscope_noise_density = 2e-4,
+                               .gyroscope_random_walk = 2e-5,
+                               .accelerometer_noise_density = 2e-3,
+                               .accelerometer_random_walk = 3e-4};
+  exportRun(options);
+  const fs::path out = root_ / "euroc_noise";
+  const std::string imu_yaml = readText(out / "mav0" / "imu0" / "sensor.yaml");
+  for (const char* line :
+       {"gyroscope_noise_density: 0.0002", "gyroscope_random_walk: 2e-05",
+        "accelerometer_noise_density: 0.002", "accelerometer_random_walk: 0.0003"}) {
+    EXPECT_NE(imu_yaml.find(line), std::string::npos) << line << "\n" << imu_yaml;
+  }
+  cv::FileStorage settings((out / "orbslam3.yaml").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(settings.isOpened());
+  EXPECT_EQ(static_cast<std::string>(settings["File.version"]), "1.0");
+  EXPECT_EQ(static_cast<std::string>(settings["Camera.type"]), "PinHole");
+  EXPECT_EQ(static_cast<double>(settings["Camera1.fx"]), 50.0);
+  EXPECT_EQ(static_cast<double>(settings["Camera1.cy"]), 23.5);
+  EXPECT_EQ(static_cast<double>(settings["Camera1.p2"]), -0.0003);
+  EXPECT_EQ(static_cast<int>(settings["Camera.width"]), 64);
+  EXPECT_EQ(static_cast<int>(settings["Camera.fps"]), 20);
+  EXPECT_EQ(static_cast<double>(settings["IMU.NoiseGyro"]), 2e-4);
+  EXPECT_EQ(static_cast<double>(settings["IMU.AccWalk"]), 3e-4);
+  EXPECT_EQ(static_cast<double>(settings["IMU.Frequency"]), 200.0);
+  cv::Mat T_b_c1;
+  settings["IMU.T_b_c1"] >> T_b_c1;
+  ASSERT_EQ(T_b_c1.rows, 4);
+  ASSERT_EQ(T_b_c1.cols, 4);
+  const Eigen::Matrix4d expected_T = bodyFromCamera().matrix();
+  for (int i = 0; i < 16; ++i) {
+    EXPECT_NEAR(T_b_c1.at<float>(i / 4, i % 4), expected_T(i / 4, i % 4), 1e-6) << i;
+  }
+
+  options.out_dir = (root_ / "euroc_no_noise").string();
+  options.imu_noise.reset();
+  const ExportSummary summary = exportRun(options);
+  cv::FileStorage mono((root_ / "euroc_no_noise" / "orbslam3.yaml").string(),
+                       cv::FileStorage::READ);
+  ASSERT_TRUE(mono.isOpened());
+  EXPECT_TRUE(mono["IMU.NoiseGyro"].empty());
+  EXPECT_EQ(static_cast<double>(mono["Camera1.fx"]), 50.0);
+  EXPECT_NE(std::find_if(summary.notes.begin(), summary.notes.end(),
+                         [](const std::string& note) {
+                           return note.find("monocular only") != std::string::npos;
+                         }),
+            summary.notes.end());
 }
 
 // RGB images keep their colours: red stays red in the PNG.
