@@ -473,6 +473,90 @@ std::string orbSlam3Settings(const Context& context) {
   return text;
 }
 
+// A 4x4 or 3x3 matrix as Kalibr writes one: a YAML list of rows.
+std::string kalibrRows(const Eigen::MatrixXd& M, const std::string& indent) {
+  std::string text;
+  for (Eigen::Index r = 0; r < M.rows(); ++r) {
+    text += indent + "- [";
+    for (Eigen::Index c = 0; c < M.cols(); ++c) {
+      const double value = std::abs(M(r, c)) < 1e-12 ? 0.0 : M(r, c);
+      text += (c > 0 ? ", " : "") + number(value);
+    }
+    text += "]\n";
+  }
+  return text;
+}
+
+// OpenVINS's three files for this camera and IMU (monocular; its EuRoC
+// configuration otherwise): Kalibr's IMU and camera-IMU chains and the
+// estimator's settings that name them. OpenVINS reads ROS topics: the EuRoC
+// folder goes into a bag first, camera on /cam0/image_raw, IMU on /imu0.
+void writeOpenVins(const Context& context, const ImuNoise& noise) {
+  const fs::path dir = context.out / "openvins";
+  createFolder(dir);
+  const auto& info = context.calibration.info;
+  const bool fisheye = info.distortion_model == msg::Distortion::EQUIDISTANT;
+  std::vector<std::string> unused;
+  const std::vector<double> k = firstCoefficients(info, 4, "Kalibr", unused);
+  const std::string header = "%YAML:1.0\n# " + sourceLine(context) + "\n\n";
+  writeText(dir / "kalibr_imu_chain.yaml",
+            header + "imu0:\n  T_i_b:\n" + kalibrRows(Eigen::Matrix4d::Identity(), "    ") +
+                "  accelerometer_noise_density: " + number(noise.accelerometer_noise_density) +
+                "\n  accelerometer_random_walk: " + number(noise.accelerometer_random_walk) +
+                "\n  gyroscope_noise_density: " + number(noise.gyroscope_noise_density) +
+                "\n  gyroscope_random_walk: " + number(noise.gyroscope_random_walk) +
+                "\n  rostopic: /imu0\n  time_offset: 0.0\n  update_rate: " +
+                number(std::round(medianRateHz(context.scan.imu))) +
+                "\n  model: \"kalibr\"\n  Tw:\n" + kalibrRows(Eigen::Matrix3d::Identity(), "    ") +
+                "  R_IMUtoGYRO:\n" + kalibrRows(Eigen::Matrix3d::Identity(), "    ") + "  Ta:\n" +
+                kalibrRows(Eigen::Matrix3d::Identity(), "    ") + "  R_IMUtoACC:\n" +
+                kalibrRows(Eigen::Matrix3d::Identity(), "    ") + "  Tg:\n" +
+                kalibrRows(Eigen::Matrix3d::Zero(), "    "));
+  const Eigen::Matrix4d T_imu_cam =
+      core::bodyToSensorIn(context.options.axes, context.calibration.T_body_cam).matrix();
+  writeText(dir / "kalibr_imucam_chain.yaml",
+            header + "cam0:\n  T_imu_cam:  # R_CtoI, p_CinI: the camera in the body (= IMU)\n" +
+                kalibrRows(T_imu_cam, "    ") +
+                "  cam_overlaps: []\n  camera_model: pinhole\n  distortion_coeffs: " + listOf(k) +
+                "\n  distortion_model: " + (fisheye ? "equidistant" : "radtan") +
+                "\n  intrinsics: [" + number(info.fx) + ", " + number(info.fy) + ", " +
+                number(info.cx) + ", " + number(info.cy) + "]  # fu, fv, cu, cv\n  resolution: [" +
+                std::to_string(info.width) + ", " + std::to_string(info.height) +
+                "]\n  rostopic: /cam0/image_raw\n");
+  writeText(
+      dir / "estimator_config.yaml",
+      header +
+          "verbosity: \"INFO\"\n\nuse_fej: true\nuse_imuavg: true\nuse_rk4int: true\n\n"
+          "use_stereo: false\nmax_cameras: 1\n\ncalib_cam_extrinsics: true\n"
+          "calib_cam_intrinsics: true\ncalib_cam_timeoffset: true\n\nmax_clones: 11\n"
+          "max_slam: 50\nmax_slam_in_update: 25\nmax_msckf_in_update: 40\ndt_slam_delay: 1\n\n"
+          "gravity_mag: 9.80665  # nadir's gravity\n\nfeat_rep_msckf: \"GLOBAL_3D\"\n"
+          "feat_rep_slam: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n"
+          "feat_rep_aruco: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n\ntry_zupt: false\n"
+          "zupt_chi2_multipler: 0\nzupt_max_velocity: 0.1\nzupt_noise_multiplier: 10\n"
+          "zupt_max_disparity: 0.5\nzupt_only_at_beginning: false\n\ninit_window_time: 2.0\n"
+          "init_imu_thresh: 1.5\ninit_max_disparity: 10.0\ninit_max_features: 75\n\n"
+          "init_dyn_use: false\ninit_dyn_min_movement: 0\ninit_dyn_mle_opt_calib: false\n"
+          "init_dyn_mle_max_iter: 50\ninit_dyn_mle_max_time: 0.05\ninit_dyn_mle_max_threads: 2\n"
+          "init_dyn_num_pose: 6\ninit_dyn_min_deg: 10.0\ninit_dyn_inflation_ori: 10\n"
+          "init_dyn_inflation_vel: 100\ninit_dyn_inflation_bg: 10\ninit_dyn_inflation_ba: 100\n"
+          "init_dyn_min_rec_cond: 1e-12\ninit_dyn_bias_g: [0.0, 0.0, 0.0]\n"
+          "init_dyn_bias_a: [0.0, 0.0, 0.0]\n\nrecord_timing_information: false\n"
+          "record_timing_filepath: \"/tmp/traj_timing.txt\"\n\nsave_total_state: false\n"
+          "filepath_est: \"/tmp/ov_estimate.txt\"\nfilepath_std: \"/tmp/ov_estimate_std.txt\"\n"
+          "filepath_gt: \"/tmp/ov_groundtruth.txt\"\n\nuse_klt: true\nnum_pts: 200\n"
+          "fast_threshold: 20\ngrid_x: 5\ngrid_y: 5\nmin_px_dist: 10\nknn_ratio: 0.70\n"
+          "track_frequency: " +
+          number(std::round(cameraRateHz(context))) +
+          "\ndownsample_cameras: false\nnum_opencv_threads: 2\n"
+          "histogram_method: \"HISTOGRAM\"\n\nuse_aruco: false\nnum_aruco: 1024\n"
+          "downsize_aruco: true\n\nup_msckf_sigma_px: 1\nup_msckf_chi2_multipler: 1\n"
+          "up_slam_sigma_px: 1\nup_slam_chi2_multipler: 1\nup_aruco_sigma_px: 1\n"
+          "up_aruco_chi2_multipler: 1\n\nuse_mask: false\n\n"
+          "relative_config_imu: \"kalibr_imu_chain.yaml\"\n"
+          "relative_config_imucam: \"kalibr_imucam_chain.yaml\"\n");
+}
+
 void writeEuroc(Context& context) {
   const fs::path mav = context.out / "mav0";
   const auto& info = context.calibration.info;
@@ -580,10 +664,12 @@ void writeEuroc(Context& context) {
                  "down), which is also the IMU frame (imu0)\n"));
 
   writeText(context.out / "orbslam3.yaml", orbSlam3Settings(context));
-  if (!context.options.imu_noise) {
+  if (context.options.imu_noise) {
+    writeOpenVins(context, *context.options.imu_noise);
+  } else {
     notes.push_back(
         "the IMU's noise is not known (no scenario.yaml beside the log): orbslam3.yaml is "
-        "monocular only and imu0/sensor.yaml has no noise figures");
+        "monocular only, imu0/sensor.yaml has no noise figures and no openvins/ is written");
   }
 
   // One timestamp per line, as ORB-SLAM3's EuRoC examples take them.

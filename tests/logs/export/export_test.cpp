@@ -490,11 +490,12 @@ TEST_F(ExportTest, EnuAxesTurnEveryPoseVectorAndExtrinsic) {
 }
 
 // With the IMU's noise known (the run's scenario), EuRoC's imu0/sensor.yaml
-// carries it and orbslam3.yaml is monocular-inertial: read back with OpenCV's
-// FileStorage (what ORB-SLAM3 reads it with), its camera is the calibration,
-// its T_b_c1 is T_body_cam and its noise the scenario's. Without it the
-// settings are monocular and a note says why.
-TEST_F(ExportTest, EurocCarriesTheImuNoiseAndOrbSlam3Settings) {
+// carries it, orbslam3.yaml is monocular-inertial and openvins/ holds OpenVINS's
+// three files: read back with OpenCV's FileStorage (what both read them with),
+// the camera is the calibration, T_b_c1 and T_imu_cam are T_body_cam and the
+// noise the scenario's. Without it the settings are monocular, there is no
+// openvins/, and a note says why.
+TEST_F(ExportTest, EurocCarriesTheImuNoiseAndSettingsForOrbSlam3AndOpenVins) {
   writeRun(log_);
   ExportOptions options;
   options.log_path = log_.string();
@@ -532,6 +533,33 @@ TEST_F(ExportTest, EurocCarriesTheImuNoiseAndOrbSlam3Settings) {
     EXPECT_NEAR(T_b_c1.at<float>(i / 4, i % 4), expected_T(i / 4, i % 4), 1e-6) << i;
   }
 
+  // OpenVINS's Kalibr chains, read back as OpenVINS reads them (OpenCV's FileStorage).
+  cv::FileStorage imu_chain((out / "openvins" / "kalibr_imu_chain.yaml").string(),
+                            cv::FileStorage::READ);
+  ASSERT_TRUE(imu_chain.isOpened());
+  EXPECT_EQ(static_cast<double>(imu_chain["imu0"]["gyroscope_noise_density"]), 2e-4);
+  EXPECT_EQ(static_cast<double>(imu_chain["imu0"]["accelerometer_random_walk"]), 3e-4);
+  EXPECT_EQ(static_cast<double>(imu_chain["imu0"]["update_rate"]), 200.0);
+  cv::FileStorage cam_chain((out / "openvins" / "kalibr_imucam_chain.yaml").string(),
+                            cv::FileStorage::READ);
+  ASSERT_TRUE(cam_chain.isOpened());
+  const cv::FileNode T_imu_cam = cam_chain["cam0"]["T_imu_cam"];
+  ASSERT_EQ(T_imu_cam.size(), 4u);
+  for (int r = 0; r < 4; ++r) {
+    ASSERT_EQ(T_imu_cam[r].size(), 4u);
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_NEAR(static_cast<double>(T_imu_cam[r][c]), expected_T(r, c), 1e-12) << r << c;
+    }
+  }
+  EXPECT_EQ(static_cast<std::string>(cam_chain["cam0"]["distortion_model"]), "radtan");
+  EXPECT_EQ(static_cast<double>(cam_chain["cam0"]["intrinsics"][0]), 50.0);
+  cv::FileStorage estimator((out / "openvins" / "estimator_config.yaml").string(),
+                            cv::FileStorage::READ);
+  ASSERT_TRUE(estimator.isOpened());
+  EXPECT_EQ(static_cast<int>(estimator["max_cameras"]), 1);
+  EXPECT_EQ(static_cast<std::string>(estimator["relative_config_imucam"]),
+            "kalibr_imucam_chain.yaml");
+
   options.out_dir = (root_ / "euroc_no_noise").string();
   options.imu_noise.reset();
   const ExportSummary summary = exportRun(options);
@@ -539,6 +567,7 @@ TEST_F(ExportTest, EurocCarriesTheImuNoiseAndOrbSlam3Settings) {
                        cv::FileStorage::READ);
   ASSERT_TRUE(mono.isOpened());
   EXPECT_TRUE(mono["IMU.NoiseGyro"].empty());
+  EXPECT_FALSE(fs::exists(root_ / "euroc_no_noise" / "openvins"));
   EXPECT_EQ(static_cast<double>(mono["Camera1.fx"]), 50.0);
   EXPECT_NE(std::find_if(summary.notes.begin(), summary.notes.end(),
                          [](const std::string& note) {
