@@ -210,17 +210,17 @@ void createFolder(const fs::path& path) {
   if (error) throw ExportError("cannot create folder " + path.string() + ": " + error.message());
 }
 
+// A rotation or transform's entry: rounding leaves 1e-16 where it has an
+// exact 0; the 0 is written.
+std::string matrixEntry(double value) { return number(std::abs(value) < 1e-12 ? 0.0 : value); }
+
 // A 4x4 matrix as EuRoC's sensor.yaml writes it (row-major data list).
 std::string yamlMatrix(const Eigen::Isometry3d& T, const std::string& indent) {
   const Eigen::Matrix4d M = T.matrix();
   std::string text = indent + "cols: 4\n" + indent + "rows: 4\n" + indent + "data: [";
   for (int r = 0; r < 4; ++r) {
     if (r > 0) text += ",\n" + indent + "       ";
-    for (int c = 0; c < 4; ++c) {
-      // Rounding leaves 1e-16 where a rotation has an exact 0; write the 0.
-      const double value = std::abs(M(r, c)) < 1e-12 ? 0.0 : M(r, c);
-      text += (c > 0 ? ", " : "") + number(value);
-    }
+    for (int c = 0; c < 4; ++c) text += (c > 0 ? ", " : "") + matrixEntry(M(r, c));
   }
   return text + "]\n";
 }
@@ -453,10 +453,7 @@ std::string orbSlam3Settings(const Context& context) {
     text +=
         "# T_b_c1: the camera in the body (= IMU) frame\nIMU.T_b_c1: !!opencv-matrix\n"
         "  rows: 4\n  cols: 4\n  dt: f\n  data: [";
-    for (int i = 0; i < 16; ++i) {
-      const double value = std::abs(T(i / 4, i % 4)) < 1e-12 ? 0.0 : T(i / 4, i % 4);
-      text += (i > 0 ? ", " : "") + number(value);
-    }
+    for (int i = 0; i < 16; ++i) text += (i > 0 ? ", " : "") + matrixEntry(T(i / 4, i % 4));
     text += "]\nIMU.NoiseGyro: " + number(noise->gyroscope_noise_density) +
             "\nIMU.NoiseAcc: " + number(noise->accelerometer_noise_density) +
             "\nIMU.GyroWalk: " + number(noise->gyroscope_random_walk) +
@@ -478,10 +475,7 @@ std::string kalibrRows(const Eigen::MatrixXd& M, const std::string& indent) {
   std::string text;
   for (Eigen::Index r = 0; r < M.rows(); ++r) {
     text += indent + "- [";
-    for (Eigen::Index c = 0; c < M.cols(); ++c) {
-      const double value = std::abs(M(r, c)) < 1e-12 ? 0.0 : M(r, c);
-      text += (c > 0 ? ", " : "") + number(value);
-    }
+    for (Eigen::Index c = 0; c < M.cols(); ++c) text += (c > 0 ? ", " : "") + matrixEntry(M(r, c));
     text += "]\n";
   }
   return text;
