@@ -135,7 +135,8 @@ CheckResult versions() {
   result.name = "versions";
   std::ostringstream text;
   text << "LCM " << LCM_MAJOR_VERSION << "." << LCM_MINOR_VERSION << "." << LCM_MICRO_VERSION
-       << ", OpenCV " << NADIR_OPENCV_VERSION << ", Qt " << NADIR_QT_VERSION << ", GeographicLib "
+       << ", OpenCV " << NADIR_OPENCV_VERSION << ", Qt " << NADIR_QT_VERSION << ", GDAL "
+       << NADIR_GDAL_VERSION << ", GeographicLib "
        << GEOGRAPHICLIB_VERSION_STRING << ", Eigen " << EIGEN_WORLD_VERSION << "."
        << EIGEN_MAJOR_VERSION << "." << EIGEN_MINOR_VERSION;
   result.detail = text.str();

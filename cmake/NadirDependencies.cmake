@@ -9,6 +9,8 @@ pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib)
 pkg_check_modules(YAMLCPP REQUIRED IMPORTED_TARGET yaml-cpp)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 pkg_check_modules(LIBTIFF REQUIRED IMPORTED_TARGET libtiff-4)
+# Terrain files in any format and CRS (CMake's FindGDAL; PROJ comes with it).
+find_package(GDAL 3.6 REQUIRED)
 pkg_check_modules(OPENGL REQUIRED IMPORTED_TARGET opengl)
 
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)

@@ -368,7 +368,37 @@ YAML::Node loadYamlFile(const std::string& path) {
   }
 }
 
+void collectLeafKeys(const YAML::Node& node, const std::string& prefix,
+                     std::vector<std::string>& keys) {
+  if (!node.IsMap()) {
+    if (!prefix.empty()) keys.push_back(prefix);
+    return;
+  }
+  for (const auto& entry : node) {
+    collectLeafKeys(entry.second, joinKey(prefix, entry.first.Scalar()), keys);
+  }
+}
+
 }  // namespace
+
+std::vector<std::string> givenKeys(const std::string& path,
+                                   const std::vector<std::string>& assignments) {
+  std::vector<std::string> keys;
+  const YAML::Node root = loadYamlFile(path);
+  if (root && root.IsMap()) collectLeafKeys(root, "", keys);
+  for (const std::string& assignment : assignments) {
+    const auto eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0) continue;
+    YAML::Node value;
+    try {
+      value = YAML::Load(assignment.substr(eq + 1));
+    } catch (const YAML::ParserException&) {
+      continue;  // applyAssignment reports it
+    }
+    collectLeafKeys(value, assignment.substr(0, eq), keys);
+  }
+  return keys;
+}
 
 void applyYamlFile(const std::string& path, const VisitParams& visit) {
   applyRoot(loadYamlFile(path), path, true, visit);

@@ -108,6 +108,11 @@ void applyYamlText(std::string_view yaml, std::string_view source, const VisitPa
 // Applies "dotted.key=value" (value in YAML syntax: 3, true, [1, 2], text).
 void applyAssignment(std::string_view assignment, std::string_view source,
                      const VisitParams& visit);
+// The dotted keys ("world.origin_lat_deg") that a YAML file and then
+// "key=value" assignments set, maps walked down to their leaves: what a user
+// gave, as opposed to the defaults.
+std::vector<std::string> givenKeys(const std::string& path,
+                                   const std::vector<std::string>& assignments);
 // Checks every current value against its spec (for values set in code).
 void validateParams(const VisitParams& visit, std::string_view source);
 // YAML text of every field with its value and documentation.

@@ -1,7 +1,8 @@
 // The DEM readers on any bytes; the first byte picks the file's name: an ESRI
 // ASCII grid (.asc), a GeoTIFF (.tif), a name that says nothing (read by
-// content), or an SRTM tile (.hgt: the input repeated to the size of a
-// 1201 x 1201 tile, so its voids and heights vary). What reads is a whole
+// content: any format the readers open through GDAL, a VRT among them), or an
+// SRTM tile (.hgt: the input repeated to the size of a 1201 x 1201 tile, so
+// its voids and heights vary). What reads is a whole
 // raster without NaN, and every height asked of it is finite or nothing.
 #include <cmath>
 #include <cstdint>

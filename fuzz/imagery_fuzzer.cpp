@@ -1,7 +1,7 @@
 // The imagery readers on any bytes; the first byte picks the reader: an RGB
-// GeoTIFF, three single-band GeoTIFFs (the input as each band), or a plain
-// image with given bounds. What reads is an 8-bit RGB raster whose colours can
-// be asked anywhere.
+// raster (.tif, read by GDAL by content), three single-band rasters (the input as each band), or a
+// plain image with given bounds. What reads is an 8-bit RGB raster whose colours can be asked
+// anywhere.
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -18,10 +18,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     ImageryRaster imagery;
     if (kind == 0) {
-      imagery = readGeoTiffRgb(nadir::fuzz::writeInput(data, size, "rgb.tif"));
+      imagery = readImageryRgb(nadir::fuzz::writeInput(data, size, "rgb.tif"));
     } else if (kind == 1) {
       const std::string band = nadir::fuzz::writeInput(data, size, "band.tif");
-      imagery = readGeoTiffBands(band, band, band);
+      imagery = readImageryBands(band, band, band);
     } else {
       imagery = readImageWithBounds(nadir::fuzz::writeInput(data, size, "image.png"),
                                     LatLonBounds{37.5, 37.1, -113.2, -112.8});

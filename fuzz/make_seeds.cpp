@@ -17,6 +17,7 @@
 #include "core/lcm_log.h"
 #include "lcmtypes/codec.h"
 #include "terrain/georef.h"
+#include "terrain/raster_file.h"
 #include "tests/terrain/terrain_test_util.h"
 
 namespace {
@@ -40,8 +41,8 @@ msg::Bytes textBytes(std::string_view text) { return msg::Bytes(text.begin(), te
 
 // A GeoTIFF of the window of a real one, with the same CRS and pixel size.
 msg::Bytes cutGeoTiff(const fs::path& source, const cv::Rect& window, const fs::path& scratch) {
-  const terrain::GeoTiffInfo info = terrain::readGeoTiffInfo(source.string());
-  const cv::Mat pixels = terrain::readGeoTiffPixels(source.string(), info)(window).clone();
+  const terrain::RasterInfo info = terrain::readRasterInfo(source.string());
+  const cv::Mat pixels = cv::imread(source.string(), cv::IMREAD_UNCHANGED)(window).clone();
   const terrain::RasterGeoref& g = info.georef;
   const bool geographic = g.crs.kind == terrain::Crs::Kind::kGeographic;
   const std::vector<std::uint16_t> keys =
@@ -80,15 +81,13 @@ void writeRasters(const fs::path& data, const fs::path& corpus) {
   const cv::Rect window(500, 600, 16, 12);
   std::vector<cv::Mat> bands;
   for (const char* band : {"zion_landsat_b4.tif", "zion_landsat_b3.tif", "zion_landsat_b2.tif"}) {
-    const terrain::GeoTiffInfo info = terrain::readGeoTiffInfo((data / band).string());
-    bands.push_back(terrain::readGeoTiffPixels((data / band).string(), info)(window).clone());
+    bands.push_back(cv::imread((data / band).string(), cv::IMREAD_UNCHANGED)(window).clone());
   }
   writeFile(imagery / "landsat_b4_cut.tif",
             cutGeoTiff(data / "zion_landsat_b4.tif", window, scratch), std::string_view("\x01", 1));
   cv::Mat rgb16;
   cv::merge(bands, rgb16);
-  const terrain::GeoTiffInfo info =
-      terrain::readGeoTiffInfo((data / "zion_landsat_b4.tif").string());
+  const terrain::RasterInfo info = terrain::readRasterInfo((data / "zion_landsat_b4.tif").string());
   const terrain::RasterGeoref& g = info.georef;
   terrain::test::writeGeoTiff(
       scratch.string(), rgb16, {g.pixel_dx, -g.pixel_dy, 0},

@@ -96,6 +96,7 @@ ScenarioParams loadScenario(const std::string& name_or_path,
   resolveRelative(params.camera.calibration_file, folder);
   for (auto& [name, spec] : params.cameras) resolveRelative(spec.calibration_file, folder);
   core::applyAssignments(params, overrides);
+  terrain::markGivenOrigin(params.world, core::givenKeys(path, overrides));
   // The guidance's source is a navigation choice, under nav in a scenario.
   params.sim.guidance.source = params.node<nav::NavNodeParams>("nav").source;
   return params;

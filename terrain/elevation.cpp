@@ -1,6 +1,7 @@
 #include "terrain/elevation.h"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -10,13 +11,18 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
+#include <numbers>
 #include <sstream>
+#include <string_view>
 
 namespace nadir::terrain {
 namespace {
 
 constexpr float kVoid = std::numeric_limits<float>::quiet_NaN();
-constexpr int16_t kSrtmVoid = -32768;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr std::uintmax_t kSrtm3Bytes = 1201u * 1201u * 2u;
+constexpr std::uintmax_t kSrtm1Bytes = 3601u * 3601u * 2u;
 
 std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -25,44 +31,110 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
-bool isImageOrArchive(const std::string& content) {
-  return content.ends_with("image") || content.ends_with("archive");
-}
-
-std::uintmax_t fileSize(const std::string& path) {
+// A .hgt that GDAL will not read: say why in SRTM's terms.
+void explainHgt(const std::string& path) {
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (error || !std::ifstream(path).good()) {
-    throw TerrainError(path + ": cannot open file");
+  if (error) return;
+  const std::string content = describeFileContent(path);
+  if (content.ends_with("image") || content.ends_with("archive")) {
+    throw TerrainError(path + ": not an SRTM .hgt file (it is a " + content + ")");
   }
-  return size;
+  if (size != kSrtm3Bytes && size != kSrtm1Bytes) {
+    throw TerrainError(path + ": " + std::to_string(size) +
+                       " bytes is not an SRTM .hgt size (2884802 for 1201 x 1201 or 25934402 "
+                       "for 3601 x 3601; truncated?)");
+  }
 }
 
-// The first "N44W072"-like pattern in the file name (so "N44W072.hgt",
-// "SRTM1_N44W072.hgt") -> south-west corner in degrees.
-bool parseSrtmName(const std::string& path, int& lat_deg, int& lon_deg) {
-  const std::string name = std::filesystem::path(path).filename().string();
-  const auto upper = [&name](std::size_t i) {
-    return static_cast<char>(std::toupper(static_cast<unsigned char>(name[i])));
-  };
-  const auto digits = [&name](std::size_t from, std::size_t count) {
-    for (std::size_t i = from; i < from + count; ++i) {
-      if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
-    }
-    return true;
-  };
-  for (std::size_t at = 0; at + 7 <= name.size(); ++at) {
-    const char ns = upper(at);
-    const char ew = upper(at + 3);
-    if ((ns != 'N' && ns != 'S') || (ew != 'E' && ew != 'W') || !digits(at + 1, 2) ||
-        !digits(at + 4, 3)) {
-      continue;
-    }
-    lat_deg = std::stoi(name.substr(at + 1, 2)) * (ns == 'S' ? -1 : 1);
-    lon_deg = std::stoi(name.substr(at + 4, 3)) * (ew == 'W' ? -1 : 1);
-    return lat_deg >= -90 && lat_deg < 90 && lon_deg >= -180 && lon_deg < 180;
+// Band 1 of region of a raster, voids NaN.
+ElevationRaster readSingleBand(const RasterInfo& info, const RasterRegion& region) {
+  const RasterWindow window = rasterWindow(info, region);
+  const BandSamples samples = readBands(info, {1}, window, false).front();
+  ElevationRaster raster;
+  raster.width = window.out_width;
+  raster.height = window.out_height;
+  raster.georef = window.georef;
+  raster.source = info.path;
+  raster.height_m.assign(samples.values.begin<float>(), samples.values.end<float>());
+  for (std::size_t i = 0; i < raster.height_m.size(); ++i) {
+    if (samples.valid.data[i] == 0) raster.height_m[i] = kVoid;
   }
-  return false;
+  return raster;
+}
+
+// Undulations of the geoid grid at geoid_path under every sample of dem,
+// added to its heights. Evaluated exactly every kKnotStep samples and
+// bilinearly between: a geoid grid is far coarser than a DEM.
+void addGeoid(ElevationRaster& dem, const std::string& geoid_path) {
+  constexpr int kKnotStep = 16;
+  const RasterInfo info = readRasterInfo(geoid_path);
+  if (info.bands != 1) {
+    throw TerrainError(geoid_path + ": a geoid grid has one band, this has " +
+                       std::to_string(info.bands));
+  }
+  const PixelGroundSize ground = dem.georef.groundPixelSize(dem.width, dem.height);
+  const PixelPoint centre{0.5 * (dem.width - 1), 0.5 * (dem.height - 1)};
+  RasterRegion region;
+  region.centre = dem.georef.geodeticFromPixel(centre);
+  region.half_size_m = 0.75 * std::max(dem.width * ground.col_m, dem.height * ground.row_m);
+  RasterInfo shifted = info;
+  // A global grid may run from 0 to 360 deg east.
+  if (info.georef.crs.kind == Crs::Kind::kGeographic) {
+    const double lon_deg = region.centre.lon_rad * kDegPerRad;
+    const double west = info.georef.corner_x;
+    if (lon_deg < west) shifted.georef.corner_x -= 360.0;
+    if (lon_deg > west + info.width * info.georef.pixel_dx) shifted.georef.corner_x += 360.0;
+  }
+  const ElevationRaster geoid = readSingleBand(shifted, region);
+
+  const auto undulation = [&](int col, int row) {
+    const core::Geodetic at = dem.georef.geodeticFromPixel({double(col), double(row)});
+    const std::optional<double> n = geoid.heightAt(at);
+    if (!n || !std::isfinite(*n)) {
+      throw TerrainError(geoid_path + ": does not cover " + dem.source + " (no undulation at " +
+                         std::to_string(at.lat_rad * kDegPerRad) + ", " +
+                         std::to_string(at.lon_rad * kDegPerRad) + " deg)");
+    }
+    return *n;
+  };
+  const auto knots = [](int size) {
+    std::vector<int> at;
+    for (int i = 0; i < size - 1; i += kKnotStep) at.push_back(i);
+    at.push_back(size - 1);
+    return at;
+  };
+  const std::vector<int> cols = knots(dem.width);
+  const std::vector<int> rows = knots(dem.height);
+  std::vector<double> n_at_knots(cols.size() * rows.size());
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      n_at_knots[r * cols.size() + c] = undulation(cols[c], rows[r]);
+    }
+  }
+  const auto [low, high] = std::minmax_element(n_at_knots.begin(), n_at_knots.end());
+  dem.geoid_min_m = *low;
+  dem.geoid_max_m = *high;
+  dem.geoid_source = geoid_path;
+  std::size_t r = 0;
+  for (int row = 0; row < dem.height; ++row) {
+    while (r + 2 < rows.size() && rows[r + 1] <= row) ++r;
+    const std::size_t r1 = std::min(r + 1, rows.size() - 1);
+    const double fr = r1 == r ? 0.0 : double(row - rows[r]) / (rows[r1] - rows[r]);
+    std::size_t c = 0;
+    for (int col = 0; col < dem.width; ++col) {
+      while (c + 2 < cols.size() && cols[c + 1] <= col) ++c;
+      const std::size_t c1 = std::min(c + 1, cols.size() - 1);
+      const double fc = c1 == c ? 0.0 : double(col - cols[c]) / (cols[c1] - cols[c]);
+      const auto knot = [&](std::size_t kr, std::size_t kc) {
+        return n_at_knots[kr * cols.size() + kc];
+      };
+      const double top = knot(r, c) + fc * (knot(r, c1) - knot(r, c));
+      const double bottom = knot(r1, c) + fc * (knot(r1, c1) - knot(r1, c));
+      dem.height_m[std::size_t(row) * std::size_t(dem.width) + std::size_t(col)] +=
+          static_cast<float>(top + fr * (bottom - top));
+    }
+  }
 }
 
 // Accumulates inverse-distance weights from the nearest valid samples on
@@ -98,173 +170,9 @@ double parseNumber(std::string_view token, const std::string& path, const std::s
   return value;
 }
 
-}  // namespace
-
-std::optional<double> ElevationRaster::heightAtPixel(const PixelPoint& pixel) const {
-  if (!(pixel.col >= -0.5 && pixel.col <= width - 0.5 && pixel.row >= -0.5 &&
-        pixel.row <= height - 0.5)) {
-    return std::nullopt;
-  }
-  return heightAtPixelClamped(pixel);
-}
-
-double ElevationRaster::heightAtPixelClamped(const PixelPoint& pixel) const {
-  if (std::isnan(pixel.col) || std::isnan(pixel.row)) {
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  const double col = std::clamp(pixel.col, 0.0, static_cast<double>(width - 1));
-  const double row = std::clamp(pixel.row, 0.0, static_cast<double>(height - 1));
-  const int c0 = std::min(static_cast<int>(col), std::max(width - 2, 0));
-  const int r0 = std::min(static_cast<int>(row), std::max(height - 2, 0));
-  const int c1 = std::min(c0 + 1, width - 1);
-  const int r1 = std::min(r0 + 1, height - 1);
-  const double fc = col - c0;
-  const double fr = row - r0;
-  const double top = at(c0, r0) + fc * (at(c1, r0) - at(c0, r0));
-  const double bottom = at(c0, r1) + fc * (at(c1, r1) - at(c0, r1));
-  return top + fr * (bottom - top);
-}
-
-std::optional<double> ElevationRaster::heightAt(const core::Geodetic& point) const {
-  return heightAtPixel(georef.pixelFromGeodetic(point));
-}
-
-int fillVoids(std::vector<float>& height_m, int width, int height, const std::string& source) {
-  std::vector<std::size_t> voids;
-  for (std::size_t i = 0; i < height_m.size(); ++i) {
-    if (std::isnan(height_m[i])) voids.push_back(i);
-  }
-  const int filled = static_cast<int>(voids.size());
-  if (voids.empty()) return 0;
-  if (voids.size() == height_m.size()) {
-    throw TerrainError(source + ": every elevation sample is a void (nodata)");
-  }
-  std::vector<int32_t> slot(height_m.size(), -1);
-  const auto w = static_cast<std::size_t>(width);
-  const auto h = static_cast<std::size_t>(height);
-  while (!voids.empty()) {
-    for (std::size_t k = 0; k < voids.size(); ++k) slot[voids[k]] = static_cast<int32_t>(k);
-    std::vector<double> weight_sum(voids.size(), 0.0);
-    std::vector<double> value_sum(voids.size(), 0.0);
-    // Only lines holding a void are scanned.
-    std::vector<char> row_has_void(h, 0);
-    std::vector<char> col_has_void(w, 0);
-    for (const std::size_t i : voids) {
-      row_has_void[i / w] = 1;
-      col_has_void[i % w] = 1;
-    }
-    for (std::size_t row = 0; row < h; ++row) {
-      if (row_has_void[row]) {
-        accumulateAlongLine(height_m, slot, row * w, 1, width, weight_sum, value_sum);
-      }
-    }
-    for (std::size_t col = 0; col < w; ++col) {
-      if (col_has_void[col]) {
-        accumulateAlongLine(height_m, slot, col, w, height, weight_sum, value_sum);
-      }
-    }
-    // Commit after the pass so that a pass only uses samples valid before it.
-    std::vector<std::size_t> remaining;
-    for (std::size_t k = 0; k < voids.size(); ++k) {
-      if (weight_sum[k] > 0.0) {
-        height_m[voids[k]] = static_cast<float>(value_sum[k] / weight_sum[k]);
-      } else {
-        remaining.push_back(voids[k]);
-      }
-    }
-    voids.swap(remaining);
-  }
-  return filled;
-}
-
-ElevationRaster readSrtmHgt(const std::string& path) {
-  const std::uintmax_t size = fileSize(path);
-  const std::string content = describeFileContent(path);
-  if (isImageOrArchive(content)) {
-    throw TerrainError(path + ": not an SRTM .hgt file (it is a " + content + ")");
-  }
-  int samples = 0;
-  if (size == 1201u * 1201u * 2u) {
-    samples = 1201;
-  } else if (size == 3601u * 3601u * 2u) {
-    samples = 3601;
-  } else {
-    throw TerrainError(path + ": " + std::to_string(size) +
-                       " bytes is not an SRTM .hgt size (2884802 for 1201 x 1201 or 25934402 "
-                       "for 3601 x 3601; truncated?)" +
-                       (content.starts_with("text") ? " (it is " + content + ")" : ""));
-  }
-  int lat_deg = 0;
-  int lon_deg = 0;
-  if (!parseSrtmName(path, lat_deg, lon_deg)) {
-    throw TerrainError(path +
-                       ": cannot tell the tile's corner from the file name (expected e.g. "
-                       "N44W072.hgt)");
-  }
-
-  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
-  std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (in.gcount() != static_cast<std::streamsize>(bytes.size())) {
-    throw TerrainError(path + ": read only " + std::to_string(in.gcount()) + " of " +
-                       std::to_string(size) + " bytes");
-  }
-
-  ElevationRaster dem;
-  dem.width = samples;
-  dem.height = samples;
-  dem.source = path;
-  dem.height_m.resize(static_cast<std::size_t>(samples) * static_cast<std::size_t>(samples));
-  for (std::size_t i = 0; i < dem.height_m.size(); ++i) {
-    const auto value =
-        static_cast<int16_t>(static_cast<uint16_t>(bytes[2 * i] << 8 | bytes[2 * i + 1]));
-    dem.height_m[i] = value == kSrtmVoid ? kVoid : static_cast<float>(value);
-  }
-  const double spacing_deg = 1.0 / (samples - 1);
-  dem.georef.crs = Crs::geographic();
-  dem.georef.pixel_dx = spacing_deg;
-  dem.georef.pixel_dy = -spacing_deg;
-  // Pixel (0,0) is centred on the tile's north-west corner.
-  dem.georef.corner_x = lon_deg - 0.5 * spacing_deg;
-  dem.georef.corner_y = lat_deg + 1 + 0.5 * spacing_deg;
-  dem.filled_voids = fillVoids(dem.height_m, dem.width, dem.height, path);
-  return dem;
-}
-
-ElevationRaster readGeoTiffElevation(const std::string& path) {
-  const GeoTiffInfo info = readGeoTiffInfo(path);
-  if (info.samples_per_pixel != 1) {
-    throw TerrainError(path + ": has " + std::to_string(info.samples_per_pixel) +
-                       " bands; a DEM has one");
-  }
-  const cv::Mat pixels = readGeoTiffPixels(path, info);
-  cv::Mat values;
-  pixels.convertTo(values, CV_64F);
-  // The nodata value as it reads back from a sample of the file's type.
-  const double nodata = info.sample_format == 3 && info.bits_per_sample == 32
-                            ? static_cast<double>(static_cast<float>(info.nodata))
-                            : info.nodata;
-
-  ElevationRaster dem;
-  dem.width = info.width;
-  dem.height = info.height;
-  dem.georef = info.georef;
-  dem.source = path;
-  dem.height_m.resize(static_cast<std::size_t>(dem.width) * static_cast<std::size_t>(dem.height));
-  for (int row = 0; row < dem.height; ++row) {
-    const double* in = values.ptr<double>(row);
-    float* out = &dem.height_m[static_cast<std::size_t>(row) * static_cast<std::size_t>(dem.width)];
-    for (int col = 0; col < dem.width; ++col) {
-      const bool is_void =
-          std::isnan(in[col]) ||
-          (info.has_nodata && (in[col] == nodata || (std::isnan(nodata) && std::isnan(in[col]))));
-      out[col] = is_void ? kVoid : static_cast<float>(in[col]);
-    }
-  }
-  dem.filled_voids = fillVoids(dem.height_m, dem.width, dem.height, path);
-  return dem;
-}
-
+// ESRI ASCII grid, strictly: GDAL's AAIGrid driver reads a missing or
+// non-numeric value as 0 and ignores extra values, so nadir keeps its own
+// reader and refuses such a file. Voids are NaN.
 ElevationRaster readEsriAsciiGrid(const std::string& path, const Crs& crs) {
   if (!std::ifstream(path).good()) throw TerrainError(path + ": cannot open file");
   const std::string content = describeFileContent(path);
@@ -368,31 +276,164 @@ ElevationRaster readEsriAsciiGrid(const std::string& path, const Crs& crs) {
     throw TerrainError(path + ": more than the " + std::to_string(count) +
                        " values the header announces");
   }
-  dem.filled_voids = fillVoids(dem.height_m, dem.width, dem.height, path);
   return dem;
 }
 
-ElevationRaster readElevation(const std::string& path) {
-  const std::string ext = lowerExtension(path);
-  if (ext == ".hgt") return readSrtmHgt(path);
-  if (ext == ".tif" || ext == ".tiff") return readGeoTiffElevation(path);
-  if (ext == ".asc") return readEsriAsciiGrid(path);
-
-  const std::uintmax_t size = fileSize(path);
-  const std::string content = describeFileContent(path);
-  if (content == "TIFF image") return readGeoTiffElevation(path);
-  if (content.starts_with("text")) {
-    std::ifstream in(path);
-    std::string first;
-    in >> first;
-    std::transform(first.begin(), first.end(), first.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (first == "ncols" || first == "nrows") return readEsriAsciiGrid(path);
+// The CRS of an ASCII grid: its .prj sidecar if it has one, else crs_if_none.
+Crs asciiGridCrs(const std::string& path, const Crs& crs_if_none) {
+  for (const char* ext : {".prj", ".PRJ"}) {
+    const std::string prj = std::filesystem::path(path).replace_extension(ext).string();
+    std::ifstream in(prj);
+    if (!in) continue;
+    std::stringstream text;
+    text << in.rdbuf();
+    return Crs::fromDefinition(text.str(), prj);
   }
-  if (size == 1201u * 1201u * 2u || size == 3601u * 3601u * 2u) return readSrtmHgt(path);
-  throw TerrainError(path + ": unknown elevation format" +
-                     (content.empty() ? std::string() : " (it is " + content + ")") +
-                     "; nadir reads SRTM .hgt, GeoTIFF and ESRI ASCII grids");
+  return crs_if_none;
+}
+
+bool looksLikeAsciiGrid(const std::string& path) {
+  if (!describeFileContent(path).starts_with("text")) return false;
+  std::ifstream in(path);
+  std::string first;
+  in >> first;
+  std::transform(first.begin(), first.end(), first.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return first == "ncols" || first == "nrows";
+}
+
+// The part of a DEM read whole that region asks for (averaged when coarser).
+ElevationRaster windowOf(ElevationRaster whole, const RasterRegion& region) {
+  RasterInfo info;
+  info.path = whole.source;
+  info.width = whole.width;
+  info.height = whole.height;
+  info.georef = whole.georef;
+  const RasterWindow window = rasterWindow(info, region);
+  const cv::Mat all(whole.height, whole.width, CV_32F, whole.height_m.data());
+  cv::Mat part = all(cv::Rect(window.col, window.row, window.width, window.height)).clone();
+  if (window.out_width != window.width || window.out_height != window.height) {
+    cv::resize(part, part, cv::Size(window.out_width, window.out_height), 0, 0, cv::INTER_AREA);
+  }
+  ElevationRaster dem = std::move(whole);
+  dem.width = window.out_width;
+  dem.height = window.out_height;
+  dem.georef = window.georef;
+  dem.height_m.assign(part.begin<float>(), part.end<float>());
+  return dem;
+}
+
+}  // namespace
+
+std::optional<double> ElevationRaster::heightAtPixel(const PixelPoint& pixel) const {
+  if (!(pixel.col >= -0.5 && pixel.col <= width - 0.5 && pixel.row >= -0.5 &&
+        pixel.row <= height - 0.5)) {
+    return std::nullopt;
+  }
+  return heightAtPixelClamped(pixel);
+}
+
+double ElevationRaster::heightAtPixelClamped(const PixelPoint& pixel) const {
+  if (std::isnan(pixel.col) || std::isnan(pixel.row)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const double col = std::clamp(pixel.col, 0.0, static_cast<double>(width - 1));
+  const double row = std::clamp(pixel.row, 0.0, static_cast<double>(height - 1));
+  const int c0 = std::min(static_cast<int>(col), std::max(width - 2, 0));
+  const int r0 = std::min(static_cast<int>(row), std::max(height - 2, 0));
+  const int c1 = std::min(c0 + 1, width - 1);
+  const int r1 = std::min(r0 + 1, height - 1);
+  const double fc = col - c0;
+  const double fr = row - r0;
+  const double top = at(c0, r0) + fc * (at(c1, r0) - at(c0, r0));
+  const double bottom = at(c0, r1) + fc * (at(c1, r1) - at(c0, r1));
+  return top + fr * (bottom - top);
+}
+
+std::optional<double> ElevationRaster::heightAt(const core::Geodetic& point) const {
+  return heightAtPixel(georef.pixelFromGeodetic(point));
+}
+
+int fillVoids(std::vector<float>& height_m, int width, int height, const std::string& source) {
+  std::vector<std::size_t> voids;
+  for (std::size_t i = 0; i < height_m.size(); ++i) {
+    if (std::isnan(height_m[i])) voids.push_back(i);
+  }
+  const int filled = static_cast<int>(voids.size());
+  if (voids.empty()) return 0;
+  if (voids.size() == height_m.size()) {
+    throw TerrainError(source + ": every elevation sample is a void (nodata)");
+  }
+  std::vector<int32_t> slot(height_m.size(), -1);
+  const auto w = static_cast<std::size_t>(width);
+  const auto h = static_cast<std::size_t>(height);
+  while (!voids.empty()) {
+    for (std::size_t k = 0; k < voids.size(); ++k) slot[voids[k]] = static_cast<int32_t>(k);
+    std::vector<double> weight_sum(voids.size(), 0.0);
+    std::vector<double> value_sum(voids.size(), 0.0);
+    // Only lines holding a void are scanned.
+    std::vector<char> row_has_void(h, 0);
+    std::vector<char> col_has_void(w, 0);
+    for (const std::size_t i : voids) {
+      row_has_void[i / w] = 1;
+      col_has_void[i % w] = 1;
+    }
+    for (std::size_t row = 0; row < h; ++row) {
+      if (row_has_void[row]) {
+        accumulateAlongLine(height_m, slot, row * w, 1, width, weight_sum, value_sum);
+      }
+    }
+    for (std::size_t col = 0; col < w; ++col) {
+      if (col_has_void[col]) {
+        accumulateAlongLine(height_m, slot, col, w, height, weight_sum, value_sum);
+      }
+    }
+    // Commit after the pass so that a pass only uses samples valid before it.
+    std::vector<std::size_t> remaining;
+    for (std::size_t k = 0; k < voids.size(); ++k) {
+      if (weight_sum[k] > 0.0) {
+        height_m[voids[k]] = static_cast<float>(value_sum[k] / weight_sum[k]);
+      } else {
+        remaining.push_back(voids[k]);
+      }
+    }
+    voids.swap(remaining);
+  }
+  return filled;
+}
+
+ElevationRaster readElevation(const std::string& path, const ElevationReadOptions& options) {
+  const std::string ext = lowerExtension(path);
+  ElevationRaster dem;
+  const bool read_whole =
+      ext == ".asc" ||
+      (ext != ".hgt" && std::filesystem::is_regular_file(path) && looksLikeAsciiGrid(path));
+  if (read_whole) {
+    dem = readEsriAsciiGrid(path, asciiGridCrs(path, options.crs_if_none));
+  } else {
+    if (ext == ".hgt") explainHgt(path);
+    RasterInfo info;
+    try {
+      info = readRasterInfo(path, options.crs_if_none);
+    } catch (const TerrainError& e) {
+      if (ext == ".hgt") {
+        throw TerrainError(std::string(e.what()) +
+                           "; an SRTM tile's file name starts with its south-west corner, e.g. "
+                           "N44W072.hgt");
+      }
+      throw;
+    }
+    if (info.bands != 1) {
+      throw TerrainError(path + ": has " + std::to_string(info.bands) + " bands; a DEM has one");
+    }
+    dem = readSingleBand(info, options.region);
+  }
+  dem.filled_voids = fillVoids(dem.height_m, dem.width, dem.height, path);
+  if (read_whole && (options.region.half_size_m > 0.0 || options.region.resolution_m > 0.0)) {
+    dem = windowOf(std::move(dem), options.region);
+  }
+  if (!options.geoid_path.empty()) addGeoid(dem, options.geoid_path);
+  return dem;
 }
 
 }  // namespace nadir::terrain

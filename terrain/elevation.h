@@ -1,12 +1,14 @@
 #pragma once
-// Digital elevation models (DEMs): SRTM .hgt tiles, GeoTIFF DEMs and ESRI
-// ASCII grids, read into one north-up raster of heights.
+// Digital elevation models (DEMs), read through GDAL into one north-up raster
+// of heights above the WGS-84 ellipsoid: SRTM .hgt tiles, GeoTIFF DEMs
+// (Copernicus, USGS 3DEP), ESRI ASCII grids, VRT mosaics of tiles, in any CRS.
 //
-// Heights are taken as heights above the WGS-84 ellipsoid. SRTM and most DEMs
-// are really heights above the EGM96/EGM2008 geoid, which lies up to ~100 m
-// from the ellipsoid (a few tens of metres in the US), but Debian ships no
-// geoid model. Over a scenario of a few tens of km the difference is a nearly
-// constant offset that raises or lowers all of the ground together.
+// DEM heights are almost always above a geoid (EGM96, EGM2008, NAVD88), which
+// lies up to about 100 m from the ellipsoid. Given a geoid grid
+// (Debian's proj-data has /usr/share/proj/egm96_15.gtx) its undulation N is
+// added: h = H + N. Without one the file's heights are taken as ellipsoid
+// heights, which over a scenario of a few tens of km raises or lowers all of
+// the ground by nearly the same offset.
 
 #include <optional>
 #include <string>
@@ -14,6 +16,7 @@
 
 #include "core/geodesy.h"
 #include "terrain/georef.h"
+#include "terrain/raster_file.h"
 
 namespace nadir::terrain {
 
@@ -24,6 +27,11 @@ struct ElevationRaster {
   RasterGeoref georef;
   std::string source;    // the file it came from
   int filled_voids = 0;  // samples that were voids/nodata and were filled
+  // The geoid grid whose undulation was added (empty: none), and the range
+  // of undulations added, m.
+  std::string geoid_source;
+  double geoid_min_m = 0.0;
+  double geoid_max_m = 0.0;
 
   float at(int col, int row) const {
     return height_m[static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
@@ -41,30 +49,32 @@ struct ElevationRaster {
   std::optional<double> heightAt(const core::Geodetic& point) const;
 };
 
-// SRTM .hgt: big-endian int16, 1201 x 1201 (3") or 3601 x 3601 (1"); the
-// tile's south-west corner from the first N44W072-like part of the file name
-// (N44W072 -> 44 N, 72 W; S12E034 -> 12 S, 34 E), pixel (0,0)
-// centred on its north-west corner; -32768 is a void.
-ElevationRaster readSrtmHgt(const std::string& path);
+struct ElevationReadOptions {
+  // The part to read (default: all of it) and how finely.
+  RasterRegion region;
+  // The CRS of a grid that names none (an ESRI ASCII grid without .prj).
+  Crs crs_if_none = Crs::geographic();
+  // A geoid grid (GTX or GeoTIFF of undulations, m) the heights are above;
+  // empty: heights are taken as ellipsoid heights.
+  std::string geoid_path;
+};
 
-// GeoTIFF DEM, one band of int8/uint8/int16/uint16/int32/float32/float64.
-// GDAL_NODATA samples (and NaN) are voids.
-ElevationRaster readGeoTiffElevation(const std::string& path);
-
-// ESRI ASCII grid: ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter,
-// cellsize (or dx and dy), optional NODATA_value, then nrows rows north
-// first. The CRS is not in the file: EPSG:4326 unless given.
-ElevationRaster readEsriAsciiGrid(const std::string& path, const Crs& crs = Crs::geographic());
-
-// Any of the above, by extension (.hgt, .tif/.tiff, .asc), else by content.
-// A file whose content is not what its name says is an error.
-ElevationRaster readElevation(const std::string& path);
+// Reads path through GDAL (raster_file.h), except ESRI ASCII grids (.asc, or
+// text starting "ncols"), which nadir reads itself, strictly, and whole:
+// ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter, cellsize (or dx
+// and dy), optional NODATA_value, then nrows rows north first; their CRS is
+// the .prj beside them, else crs_if_none. Nodata samples (and NaN) are voids,
+// filled with fillVoids. Throws TerrainError naming the file for a file that
+// cannot be read, a DEM with more than one band, one without georeferencing
+// or whose every sample is a void, and a geoid grid that does not cover it.
+ElevationRaster readElevation(const std::string& path, const ElevationReadOptions& options = {});
 
 // Fills NaN samples from the nearest valid samples left, right, above and
-// below, weighted by inverse distance (exact along a straight slope); voids
-// with no valid sample in their row or column are filled in later passes from
-// filled neighbours. Returns how many samples were filled. Throws
-// TerrainError naming source if no sample is valid.
+// below, weighted by inverse distance (exact along a straight slope, where
+// GDAL 3.6's GDALFillNodata is off by half a pixel's rise: docs/terrain.md);
+// voids with no valid sample in their row or column are filled in later
+// passes from filled neighbours. Returns how many samples were filled.
+// Throws TerrainError naming source if no sample is valid.
 int fillVoids(std::vector<float>& height_m, int width, int height, const std::string& source);
 
 }  // namespace nadir::terrain

@@ -9,10 +9,9 @@
 // [-0.5, width - 0.5] x [-0.5, height - 0.5].
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
-
-#include <opencv2/core/mat.hpp>
 
 #include "core/geodesy.h"
 
@@ -37,35 +36,48 @@ struct PixelPoint {
   double row = 0.0;
 };
 
-// The coordinate reference systems nadir reads: WGS-84 geographic (EPSG:4326,
-// x = longitude, y = latitude, degrees) and WGS-84 UTM (EPSG:326zz north,
-// 327zz south, metres).
+class CrsTransform;  // PROJ's transformations for a CRS without a fast path
+
+// A coordinate reference system: any CRS that GDAL and PROJ know (EPSG code,
+// WKT, PROJ string). WGS-84 geographic (x = longitude, y = latitude, degrees)
+// and WGS-84 UTM are computed by GeographicLib; every other CRS (NAD83 UTM,
+// ETRS89 / LAEA, ...) goes through PROJ. Axes are always x east, y north
+// (longitude first), whatever order the CRS's definition gives.
 struct Crs {
-  enum class Kind { kGeographic, kUtm };
+  enum class Kind { kGeographic, kUtm, kOther };
   Kind kind = Kind::kGeographic;
   int utm_zone = 0;  // 1..60 for kUtm
   bool utm_north = true;
+  std::shared_ptr<const CrsTransform> other;  // kOther only
 
   static Crs geographic() { return Crs{}; }
   // Throws TerrainError for a zone outside 1..60.
   static Crs utm(int zone, bool north);
-  // EPSG:4326, 32601..32660, 32701..32760; anything else is a TerrainError
-  // naming source (the file the code came from) and the code.
+  // Any EPSG code PROJ knows; 4326 and 32601..32660, 32701..32760 get the
+  // fast paths. An unknown code, or a CRS that is not geographic or
+  // projected (a vertical CRS, say) is a TerrainError naming source.
   static Crs fromEpsg(int epsg, const std::string& source);
+  // A CRS from its WKT (as GDAL gives it for a raster), or from anything
+  // OGRSpatialReference::SetFromUserInput takes ("EPSG:26912", a PROJ string).
+  static Crs fromDefinition(const std::string& definition, const std::string& source);
 
-  int epsg() const;
-  std::string name() const;  // "EPSG:4326 (WGS 84)", "EPSG:32612 (UTM 12N)"
+  int epsg() const;  // the CRS's EPSG code, 0 if it has none
+  std::string name()
+      const;  // "EPSG:4326 (WGS 84)", "EPSG:32612 (UTM 12N)", "EPSG:26912 (NAD83 / UTM zone 12N)"
+  std::string wkt() const;  // OGC WKT 1, for writing files
 
-  // Geodetic -> CRS. UTM always uses this CRS's zone and hemisphere, with
-  // GeographicLib's TransverseMercator::UTM() (what GeographicLib::UTMUPS
-  // computes when given the zone, but without UTMUPS's range check, so a
-  // point beyond the zone still maps, to an easting outside the usual range).
-  // NaN coordinates for a latitude beyond +-90 deg.
+  // Geodetic (WGS-84) -> CRS. UTM always uses this CRS's zone and hemisphere,
+  // with GeographicLib's TransverseMercator::UTM() (what GeographicLib::UTMUPS
+  // computes when given the zone, but without UTMUPS's range check, so a point
+  // beyond the zone still maps, to an easting outside the usual range). NaN
+  // coordinates for a latitude beyond +-90 deg or a point PROJ cannot map.
   CrsPoint fromGeodetic(const core::Geodetic& point) const;
-  // CRS -> geodetic with height alt_m.
+  // CRS -> geodetic (WGS-84) with height alt_m.
   core::Geodetic toGeodetic(const CrsPoint& point, double alt_m = 0.0) const;
 
-  bool operator==(const Crs& other) const = default;
+  // Same kind, zone and hemisphere; for kOther, the same CRS by PROJ's
+  // judgement (axis order and names aside).
+  bool operator==(const Crs& other) const;
 };
 
 // Ground size of one pixel, metres.
@@ -112,31 +124,6 @@ struct RasterGeoref {
   // relative.
   bool sameGrid(const RasterGeoref& other) const;
 };
-
-// What a GeoTIFF says about itself (libtiff, GeoTIFF 1.0 tags).
-struct GeoTiffInfo {
-  int width = 0;
-  int height = 0;
-  int samples_per_pixel = 0;
-  int bits_per_sample = 0;
-  int sample_format = 1;  // 1 unsigned, 2 signed integer, 3 IEEE float
-  RasterGeoref georef;
-  bool pixel_is_point = false;  // GTRasterTypeGeoKey = 2
-  bool has_nodata = false;      // GDAL_NODATA tag present
-  double nodata = 0.0;
-};
-
-// Reads the header and georeferencing (ModelPixelScale + ModelTiepoint or a
-// north-up ModelTransformation, GeoKeyDirectory, GDAL_NODATA) of a GeoTIFF.
-// A PixelIsPoint tiepoint is a pixel centre, a PixelIsArea one a pixel
-// corner. Throws TerrainError naming path if the file is not a TIFF, has no
-// or unsupported georeferencing (CRS, rotation, south-up).
-GeoTiffInfo readGeoTiffInfo(const std::string& path);
-
-// The pixels of a GeoTIFF (cv::imread, IMREAD_UNCHANGED), checked against
-// info: same size, channel count and sample type. Multi-channel images are
-// returned in file order (R first), not OpenCV's BGR.
-cv::Mat readGeoTiffPixels(const std::string& path, const GeoTiffInfo& info);
 
 // "PNG image", "JPEG image", "TIFF image", "text" ... from a file's first
 // bytes, for error messages; empty if unrecognised.

@@ -13,24 +13,6 @@
 namespace nadir::terrain {
 namespace {
 
-// Non-zero where a single-band image is not nodata (and not NaN).
-cv::Mat validMask(const cv::Mat& band, const GeoTiffInfo& info) {
-  cv::Mat values;
-  band.convertTo(values, CV_64F);
-  const double nodata = info.sample_format == 3 && info.bits_per_sample == 32
-                            ? static_cast<double>(static_cast<float>(info.nodata))
-                            : info.nodata;
-  cv::Mat valid(band.size(), CV_8U);
-  for (int row = 0; row < band.rows; ++row) {
-    const double* in = values.ptr<double>(row);
-    auto* out = valid.ptr<unsigned char>(row);
-    for (int col = 0; col < band.cols; ++col) {
-      out[col] = std::isnan(in[col]) || (info.has_nodata && in[col] == nodata) ? 0 : 255;
-    }
-  }
-  return valid;
-}
-
 void checkStretch(const StretchParams& stretch, const std::string& source) {
   if (!(stretch.low_percent >= 0.0 && stretch.low_percent < stretch.high_percent &&
         stretch.high_percent <= 100.0)) {
@@ -120,40 +102,43 @@ cv::Mat stretchBand(const cv::Mat& band, const cv::Mat& valid, const StretchPara
   return out;
 }
 
-ImageryRaster readGeoTiffRgb(const std::string& path, const StretchParams& stretch) {
+ImageryRaster readImageryRgb(const std::string& path, const RasterRegion& region,
+                             const StretchParams& stretch, const Crs& crs_if_none) {
   checkStretch(stretch, path);
-  const GeoTiffInfo info = readGeoTiffInfo(path);
-  if (info.samples_per_pixel != 3 && info.samples_per_pixel != 4) {
-    throw TerrainError(path + ": has " + std::to_string(info.samples_per_pixel) +
+  const RasterInfo info = readRasterInfo(path, crs_if_none);
+  if (info.bands != 3 && info.bands != 4) {
+    throw TerrainError(path + ": has " + std::to_string(info.bands) +
                        " bands; RGB imagery needs 3 (or 4 with alpha)");
   }
-  const cv::Mat pixels = readGeoTiffPixels(path, info);
-  std::vector<cv::Mat> bands;
-  cv::split(pixels, bands);
-  bands.resize(3);
+  const RasterWindow window = rasterWindow(info, region);
+  const std::vector<BandSamples> samples = readBands(info, {1, 2, 3}, window, true);
   ImageryRaster imagery;
-  imagery.georef = info.georef;
+  imagery.georef = window.georef;
   imagery.source = path;
-  if (pixels.depth() == CV_8U) {
-    cv::merge(bands, imagery.rgb);
-    return imagery;
+  std::vector<cv::Mat> bands;
+  if (std::all_of(samples.begin(), samples.end(),
+                  [](const BandSamples& band) { return band.values.depth() == CV_8U; })) {
+    for (const BandSamples& band : samples) bands.push_back(band.values);
+  } else {
+    cv::Mat valid = samples[0].valid & samples[1].valid & samples[2].valid;
+    for (const BandSamples& band : samples) {
+      bands.push_back(stretchBand(band.values, valid, stretch, path));
+    }
   }
-  cv::Mat valid(pixels.size(), CV_8U, cv::Scalar(255));
-  for (const cv::Mat& band : bands) valid &= validMask(band, info);
-  for (cv::Mat& band : bands) band = stretchBand(band, valid, stretch, path);
   cv::merge(bands, imagery.rgb);
   return imagery;
 }
 
-ImageryRaster readGeoTiffBands(const std::string& red_path, const std::string& green_path,
-                               const std::string& blue_path, const StretchParams& stretch) {
+ImageryRaster readImageryBands(const std::string& red_path, const std::string& green_path,
+                               const std::string& blue_path, const RasterRegion& region,
+                               const StretchParams& stretch, const Crs& crs_if_none) {
   checkStretch(stretch, red_path);
   const std::array<std::string, 3> paths{red_path, green_path, blue_path};
-  std::array<GeoTiffInfo, 3> infos;
+  std::array<RasterInfo, 3> infos;
   for (std::size_t k = 0; k < 3; ++k) {
-    infos[k] = readGeoTiffInfo(paths[k]);
-    if (infos[k].samples_per_pixel != 1) {
-      throw TerrainError(paths[k] + ": has " + std::to_string(infos[k].samples_per_pixel) +
+    infos[k] = readRasterInfo(paths[k], crs_if_none);
+    if (infos[k].bands != 1) {
+      throw TerrainError(paths[k] + ": has " + std::to_string(infos[k].bands) +
                          " bands; expected a single band");
     }
   }
@@ -171,18 +156,20 @@ ImageryRaster readGeoTiffBands(const std::string& red_path, const std::string& g
                          "), pixel " + std::to_string(b.pixel_dx));
     }
   }
-  std::array<cv::Mat, 3> pixels;
-  cv::Mat valid(infos[0].height, infos[0].width, CV_8U, cv::Scalar(255));
+  const RasterWindow window = rasterWindow(infos[0], region);
+  std::array<BandSamples, 3> samples;
+  cv::Mat valid(window.out_height, window.out_width, CV_8U, cv::Scalar(255));
   for (std::size_t k = 0; k < 3; ++k) {
-    pixels[k] = readGeoTiffPixels(paths[k], infos[k]);
-    valid &= validMask(pixels[k], infos[k]);
+    samples[k] = std::move(readBands(infos[k], {1}, window, false).front());
+    valid &= samples[k].valid;
   }
   std::vector<cv::Mat> bands(3);
-  for (std::size_t k = 0; k < 3; ++k) bands[k] = stretchBand(pixels[k], valid, stretch, paths[k]);
-
+  for (std::size_t k = 0; k < 3; ++k) {
+    bands[k] = stretchBand(samples[k].values, valid, stretch, paths[k]);
+  }
   ImageryRaster imagery;
   cv::merge(bands, imagery.rgb);
-  imagery.georef = infos[0].georef;
+  imagery.georef = window.georef;
   imagery.source = red_path + "," + green_path + "," + blue_path;
   return imagery;
 }

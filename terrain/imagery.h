@@ -1,6 +1,6 @@
 #pragma once
-// Georeferenced 8-bit RGB imagery: an RGB GeoTIFF, separate single-band
-// GeoTIFFs (e.g. Landsat bands) combined with a percentile stretch, or a plain
+// Georeferenced 8-bit RGB imagery: an RGB raster, separate single-band
+// rasters (e.g. Landsat bands) combined with a percentile stretch, or a plain
 // PNG/JPEG with known corner coordinates.
 
 #include <optional>
@@ -11,6 +11,7 @@
 #include "core/geodesy.h"
 #include "core/params.h"
 #include "terrain/georef.h"
+#include "terrain/raster_file.h"
 
 namespace nadir::terrain {
 
@@ -46,15 +47,21 @@ struct ImageryRaster {
                                     Sampling sampling = Sampling::kBilinear) const;
 };
 
-// RGB(A) GeoTIFF: 8-bit samples as they are, 16-bit (or other) samples
-// stretched per band. Alpha is dropped.
-ImageryRaster readGeoTiffRgb(const std::string& path, const StretchParams& stretch = {});
+// RGB(A) imagery in any raster GDAL reads (raster_file.h): 8-bit samples as
+// they are, 16-bit (or other) samples stretched per band (the percentiles of
+// the region read). Alpha is dropped. A file naming no CRS is taken to be in
+// crs_if_none.
+ImageryRaster readImageryRgb(const std::string& path, const RasterRegion& region = {},
+                             const StretchParams& stretch = {},
+                             const Crs& crs_if_none = Crs::geographic());
 
-// Three single-band GeoTIFFs on the same grid (else TerrainError naming the
-// files) combined into RGB, each band stretched. GDAL_NODATA samples are left
-// out of the percentiles and come out black.
-ImageryRaster readGeoTiffBands(const std::string& red_path, const std::string& green_path,
-                               const std::string& blue_path, const StretchParams& stretch = {});
+// Three single-band rasters on the same grid (else TerrainError naming the
+// files), e.g. Landsat bands, combined into RGB, each band stretched. Nodata
+// samples are left out of the percentiles and come out black.
+ImageryRaster readImageryBands(const std::string& red_path, const std::string& green_path,
+                               const std::string& blue_path, const RasterRegion& region = {},
+                               const StretchParams& stretch = {},
+                               const Crs& crs_if_none = Crs::geographic());
 
 // Outer edges of an image in EPSG:4326, degrees.
 struct LatLonBounds {

@@ -22,8 +22,19 @@ struct WorldParams {
   ProceduralWorldParams procedural;
   CheckerboardParams checkerboard;
   ArenaParams arena;
-  // files: a DEM (.hgt, GeoTIFF, ESRI .asc).
+  // files: a DEM GDAL reads (.hgt, GeoTIFF, .asc, a .vrt mosaic ...).
   std::string dem_path;
+  // files: the CRS of a DEM or imagery file that names none (an .asc
+  // without .prj, an image with only a world file).
+  std::string default_crs = "EPSG:4326";
+  // files: a geoid grid the DEM's heights are above; empty: they are taken
+  // as heights above the ellipsoid.
+  std::string geoid_file;
+  // files: half the side of the square read around the origin, m; 0: all of
+  // the files.
+  double extent_m = 0.0;
+  // files: the coarsest ground pixel wanted, m; 0: the files' own.
+  double resolution_m = 0.0;
   // files: imagery as one RGB GeoTIFF, or a plain image with imagery_bounds_deg;
   // empty with the band paths below; all empty: the DEM's shaded relief.
   std::string imagery_path;
@@ -33,7 +44,9 @@ struct WorldParams {
   // Plain image corners: north, south, west, east latitude/longitude, deg.
   std::vector<double> imagery_bounds_deg = {0.0, 0.0, 0.0, 0.0};
   // The world frame's origin (WGS-84, deg and m above the ellipsoid). With
-  // files and origin_at_dem_centre, the DEM's centre at its ground height.
+  // files and origin_at_dem_centre, the DEM's centre at its ground height;
+  // a scenario that gives the origin but not origin_at_dem_centre turns it
+  // off (markGivenOrigin).
   double origin_lat_deg = 0.0;
   double origin_lon_deg = 0.0;
   double origin_alt_m = 0.0;
@@ -56,6 +69,12 @@ BuiltWorld makeWorld(const WorldParams& params);
 // over (a checkerboard world is a calibration board a few decimetres across:
 // nadir calib --virtual looks at it).
 void requireFlightWorld(const WorldParams& params);
+
+// After loading a scenario whose text names the keys in given_keys (dotted,
+// "world.origin_lat_deg"): an origin given without origin_at_dem_centre is
+// the origin to use, also for a files world.
+void markGivenOrigin(WorldParams& params, const std::vector<std::string>& given_keys,
+                     const std::string& prefix = "world.");
 
 // Makes the world's relative file paths relative to `folder` (the folder of
 // the file that named them).

@@ -442,6 +442,41 @@ TEST(Scenario, RelativePathsFollowTheFile) {
   EXPECT_EQ(scenario.sim.flight.path, (folder / "flights/one.csv").string());
 }
 
+// A files world centres on its DEM unless the scenario gives an origin:
+// giving origin_lat_deg/lon_deg (in the file or with --set) is enough;
+// origin_at_dem_centre given as well wins (so a formatted scenario, which
+// writes both, loads back as it was).
+TEST(Scenario, AGivenOriginIsUsedForAFilesWorld) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  const std::filesystem::path folder =
+      std::filesystem::path(::testing::TempDir()) / "nadir_scenario_origin";
+  std::filesystem::create_directories(folder);
+  const std::string dem = std::string(NADIR_TEST_DATA_DIR) + "/terrain/zion_srtm.tif";
+  const auto write = [&](const std::string& name, const std::string& world_lines) {
+    const std::filesystem::path path = folder / name;
+    std::ofstream(path) << "world:\n  kind: files\n  dem_path: " << dem << "\n" << world_lines;
+    return path.string();
+  };
+  // zion_srtm.tif's centre: lat (37.1321 + 37.5129) / 2, lon (-113.2396 - 112.8521) / 2.
+  const core::Geodetic centre = scenarioOrigin(loadScenario(write("centre.yaml", "")));
+  EXPECT_NEAR(centre.lat_rad / kDeg, 37.3225, 1e-3);
+  EXPECT_NEAR(centre.lon_rad / kDeg, -113.04585, 1e-3);
+
+  const std::string given =
+      write("given.yaml", "  origin_lat_deg: 37.25\n  origin_lon_deg: -113.1\n");
+  const core::Geodetic at = scenarioOrigin(loadScenario(given));
+  EXPECT_NEAR(at.lat_rad / kDeg, 37.25, 1e-12);
+  EXPECT_NEAR(at.lon_rad / kDeg, -113.1, 1e-12);
+
+  const core::Geodetic set = scenarioOrigin(loadScenario(
+      write("set.yaml", ""), {"world.origin_lat_deg=37.2", "world.origin_lon_deg=-113"}));
+  EXPECT_NEAR(set.lat_rad / kDeg, 37.2, 1e-12);
+
+  const core::Geodetic both = scenarioOrigin(
+      loadScenario(write("both.yaml", "  origin_lat_deg: 37.25\n  origin_at_dem_centre: true\n")));
+  EXPECT_NEAR(both.lat_rad / kDeg, 37.3225, 1e-3);
+}
+
 // A real flight from a CSV comes back out of the POSE_TRUTH stream within the
 // interpolation error: a 200 m circle at 20 m/s sampled at 10 Hz, replayed at 400 Hz.
 TEST(Scenario, FlightCsvRoundTripsThroughTheTruthStream) {

@@ -1,5 +1,9 @@
 #include "terrain/elevation.h"
 
+#include <clocale>
+#include <cstdio>
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/geodesy.h"
+#include "terrain/raster_file.h"
 
 #include "terrain_test_util.h"
 
@@ -65,7 +70,7 @@ void expectTerrainError(F read, const std::string& path, const std::string& what
 TEST(SrtmHgt, WhiteMountainsTileFacts) {
   // N44W072.hgt: 1201 x 1201, highest sample 1908 m at row 875, column 836
   // (Mount Washington), lowest 115 m, no voids.
-  const ElevationRaster dem = readSrtmHgt(dataPath("N44W072.hgt"));
+  const ElevationRaster dem = readElevation(dataPath("N44W072.hgt"));
   ASSERT_EQ(dem.width, 1201);
   ASSERT_EQ(dem.height, 1201);
   EXPECT_EQ(dem.filled_voids, 0);
@@ -78,7 +83,7 @@ TEST(SrtmHgt, WhiteMountainsTileFacts) {
 
 TEST(SrtmHgt, CornerPixelsAreCentredOnWholeDegrees) {
   // Pixel (0,0) is centred on (45 N, 72 W), pixel (1200, 1200) on (44 N, 71 W).
-  const ElevationRaster dem = readSrtmHgt(dataPath("N44W072.hgt"));
+  const ElevationRaster dem = readElevation(dataPath("N44W072.hgt"));
   const core::Geodetic nw = dem.georef.geodeticFromPixel({0, 0});
   EXPECT_NEAR(nw.lat_rad * kDegPerRad, 45.0, 1e-12);
   EXPECT_NEAR(nw.lon_rad * kDegPerRad, -72.0, 1e-12);
@@ -102,12 +107,12 @@ TEST(SrtmHgt, MountWashingtonHeightAt) {
 TEST(SrtmHgt, SouthEastNameAndVoidFilling) {
   // S12E034.hgt has its north-west sample on (11 S, 34 E); its voids (-32768)
   // in a field of height = 10 * row are filled with 10 * row.
-  const std::string path = tempPath("S12E034.hgt");
+  const std::string path = test::tempFolderPath("S12E034.hgt");
   writeHgt(path, [](int col, int row) {
     const bool hole = (row == 600 && col >= 300 && col < 310) || (row == 5 && col == 7);
     return hole ? -32768 : 10 * row;
   });
-  const ElevationRaster dem = readSrtmHgt(path);
+  const ElevationRaster dem = readElevation(path);
   const core::Geodetic nw = dem.georef.geodeticFromPixel({0, 0});
   EXPECT_NEAR(nw.lat_rad * kDegPerRad, -11.0, 1e-12);
   EXPECT_NEAR(nw.lon_rad * kDegPerRad, 34.0, 1e-12);
@@ -121,7 +126,7 @@ TEST(SrtmHgt, SouthEastNameAndVoidFilling) {
 TEST(GeoTiffElevation, ZionFacts) {
   // zion_srtm.tif: uint16, EPSG:4326, 465 x 457, lon -113.2396..-112.8521,
   // lat 37.1321..37.5129, heights 1024..2892 m, no voids.
-  const ElevationRaster dem = readGeoTiffElevation(dataPath("zion_srtm.tif"));
+  const ElevationRaster dem = readElevation(dataPath("zion_srtm.tif"));
   ASSERT_EQ(dem.width, 465);
   ASSERT_EQ(dem.height, 457);
   EXPECT_EQ(dem.georef.crs, Crs::geographic());
@@ -207,7 +212,7 @@ TEST(EsriAsciiGrid, CornerAndCentreOrigins) {
   const std::string centre = tempPath("centre.asc");
   writeText(centre, "NCOLS 3\nNROWS 2\nXLLCENTER 10\nYLLCENTER 20\nCELLSIZE 0.5\n1 2 3\n4 5 6\n");
   const ElevationRaster a = readElevation(corner);
-  const ElevationRaster b = readEsriAsciiGrid(centre);
+  const ElevationRaster b = readElevation(centre);
   const CrsPoint a_ll = a.georef.crsFromPixel({0, 1});
   EXPECT_NEAR(a_ll.x, 10.25, 1e-12);
   EXPECT_NEAR(a_ll.y, 20.25, 1e-12);
@@ -227,7 +232,9 @@ TEST(EsriAsciiGrid, GivenCrsAndBadContent) {
   // key are errors naming the file.
   const std::string utm = tempPath("utm.asc");
   writeText(utm, "ncols 2\nnrows 1\nxllcorner 300000\nyllcorner 4100000\ncellsize 30\n7 8\n");
-  const ElevationRaster dem = readEsriAsciiGrid(utm, Crs::utm(12, true));
+  ElevationReadOptions in_utm;
+  in_utm.crs_if_none = Crs::utm(12, true);
+  const ElevationRaster dem = readElevation(utm, in_utm);
   EXPECT_EQ(dem.georef.crs, Crs::utm(12, true));
   EXPECT_DOUBLE_EQ(dem.georef.corner_y, 4100030.0);
 
@@ -244,7 +251,7 @@ TEST(EsriAsciiGrid, GivenCrsAndBadContent) {
 
 TEST(ReadElevation, MalformedFilesNameThePath) {
   // Truncated and wrongly sized .hgt, a PNG renamed .hgt, a text file renamed
-  // .tif, a GeoTIFF cut in half, an unsupported CRS (EPSG:3857), a .hgt with
+  // .tif, a GeoTIFF cut in half, a rotated raster, a .hgt with
   // no tile name, an RGB "DEM" and a missing file: each a TerrainError naming
   // the file and what is wrong.
   const std::string truncated = tempPath("N10E010.hgt");
@@ -263,7 +270,7 @@ TEST(ReadElevation, MalformedFilesNameThePath) {
 
   const std::string text = tempPath("dem_text.tif");
   writeText(text, "hello, I am not a GeoTIFF\n");
-  expectTerrainError([&] { readElevation(text); }, text, "not a TIFF");
+  expectTerrainError([&] { readElevation(text); }, text, "text starting 'hello");
 
   const std::string cut_tiff = tempPath("cut_zion.tif");
   {
@@ -274,14 +281,14 @@ TEST(ReadElevation, MalformedFilesNameThePath) {
   }
   expectTerrainError([&] { readElevation(cut_tiff); }, cut_tiff, "truncated");
 
-  const std::string mercator = tempPath("dem_3857.tif");
-  writeGeoTiff(mercator, cv::Mat(2, 2, CV_16S, cv::Scalar(1)), {30, 30, 0}, {0, 0, 0, 0, 0, 0},
-               geoKeys({{1024, 1}, {1025, 1}, {3072, 3857}}));
-  expectTerrainError([&] { readElevation(mercator); }, mercator, "3857");
+  const std::string rotated = tempPath("dem_rotated.tif");
+  writeGeoTiff(rotated, cv::Mat(2, 2, CV_16S, cv::Scalar(1)), {}, {}, geographicKeys(), "",
+               {0.01, 0.002, 0, 7, 0.002, -0.01, 0, 46, 0, 0, 0, 0, 0, 0, 0, 1});
+  expectTerrainError([&] { readElevation(rotated); }, rotated, "rotated");
 
   const std::string unnamed = tempPath("tile.hgt");
   writeHgt(unnamed, [](int, int) { return 1; });
-  expectTerrainError([&] { readElevation(unnamed); }, unnamed, "file name");
+  expectTerrainError([&] { readElevation(unnamed); }, unnamed, "file name starts with");
 
   const std::string rgb = tempPath("rgb_dem.tif");
   writeGeoTiff(rgb, cv::Mat(2, 2, CV_8UC3, cv::Scalar(1, 2, 3)), {1, 1, 0}, {0, 0, 0, 0, 0, 0},
@@ -304,7 +311,235 @@ TEST(ReadElevation, DispatchesOnContentWithoutKnownExtension) {
   EXPECT_EQ(readElevation(grid).at(0, 0), 17.0f);
   const std::string bin = tempPath("random.bin");
   std::ofstream(bin, std::ios::binary) << std::string("\x01\x02\x03\x80\x90", 5);
-  expectTerrainError([&] { readElevation(bin); }, bin, "unknown elevation format");
+  expectTerrainError([&] { readElevation(bin); }, bin, "not a raster nadir can read");
+}
+
+// zion_srtm.tif's samples as they are in the file (uint16, row 0 north).
+cv::Mat zionSamples() { return cv::imread(dataPath("zion_srtm.tif"), cv::IMREAD_UNCHANGED); }
+
+// Writes columns [first_col, first_col + cols) of zion_srtm.tif as a
+// geographic GeoTIFF on the same grid.
+void writeZionColumns(const std::string& path, int first_col, int cols) {
+  const RasterGeoref zion = readRasterInfo(dataPath("zion_srtm.tif")).georef;
+  const cv::Mat samples = zionSamples();
+  writeGeoTiff(path, samples.colRange(first_col, first_col + cols).clone(),
+               {zion.pixel_dx, -zion.pixel_dy, 0},
+               {0, 0, 0, zion.corner_x + first_col * zion.pixel_dx, zion.corner_y, 0},
+               geographicKeys());
+}
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", value);
+  return text;
+}
+
+TEST(GdalTerrain, TwoTileVrtReadsAsTheWholeFile) {
+  // zion_srtm.tif cut into a west tile (232 columns) and an east one (233),
+  // joined again by a VRT written by hand: the mosaic is the whole file
+  // sample for sample, and a flight line across the seam sees the same
+  // ground in both.
+  const std::string west = test::tempFolderPath("zion_west.tif");
+  const std::string east = test::tempFolderPath("zion_east.tif");
+  writeZionColumns(west, 0, 232);
+  writeZionColumns(east, 232, 233);
+  const RasterGeoref zion = readRasterInfo(dataPath("zion_srtm.tif")).georef;
+  const auto source = [](const std::string& file, int x_off, int cols) {
+    return "    <SimpleSource>\n      <SourceFilename relativeToVRT=\"1\">" + file +
+           "</SourceFilename>\n      <SourceBand>1</SourceBand>\n      <SrcRect xOff=\"0\" "
+           "yOff=\"0\" xSize=\"" +
+           std::to_string(cols) + "\" ySize=\"457\"/>\n      <DstRect xOff=\"" +
+           std::to_string(x_off) + "\" yOff=\"0\" xSize=\"" + std::to_string(cols) +
+           "\" ySize=\"457\"/>\n    </SimpleSource>\n";
+  };
+  const std::string vrt = test::tempFolderPath("zion_mosaic.vrt");
+  writeText(vrt,
+            "<VRTDataset rasterXSize=\"465\" rasterYSize=\"457\">\n  <SRS>EPSG:4326</SRS>\n"
+            "  <GeoTransform>" +
+                number(zion.corner_x) + ", " + number(zion.pixel_dx) + ", 0, " +
+                number(zion.corner_y) + ", 0, " + number(zion.pixel_dy) +
+                "</GeoTransform>\n  <VRTRasterBand dataType=\"UInt16\" band=\"1\">\n" +
+                source("zion_west.tif", 0, 232) + source("zion_east.tif", 232, 233) +
+                "  </VRTRasterBand>\n</VRTDataset>\n");
+  EXPECT_EQ(readRasterInfo(vrt).driver, "VRT");
+  const ElevationRaster mosaic = readElevation(vrt);
+  const ElevationRaster whole = readElevation(dataPath("zion_srtm.tif"));
+  ASSERT_EQ(mosaic.width, 465);
+  ASSERT_EQ(mosaic.height, 457);
+  EXPECT_TRUE(mosaic.georef.sameGrid(whole.georef));
+  EXPECT_EQ(mosaic.height_m, whole.height_m);
+  const double seam_lon_deg = zion.corner_x + 232 * zion.pixel_dx;
+  for (const double d_deg : {-0.003, -0.0001, 0.0001, 0.003}) {
+    const core::Geodetic at = core::geodeticFromDegrees(37.3, seam_lon_deg + d_deg, 0.0);
+    EXPECT_EQ(mosaic.heightAt(at), whole.heightAt(at)) << d_deg;
+    EXPECT_TRUE(mosaic.heightAt(at).has_value());
+  }
+}
+
+TEST(GdalTerrain, AWindowIsTheSameSamplesAsTheWholeFile) {
+  // The 4 km square around (37.3 N, 113.0 W): 4000 m / 73.8 m = 54.2
+  // columns and 4000 m / 92.5 m = 43.2 rows of the 3" grid (3" of longitude
+  // is 92.8 m x cos 37.3 deg), plus two pixels of margin each side and up to
+  // two more for rounding; each sample is the whole file's at the same place.
+  const ElevationRaster whole = readElevation(dataPath("zion_srtm.tif"));
+  ElevationReadOptions options;
+  options.region.centre = core::geodeticFromDegrees(37.3, -113.0, 0.0);
+  options.region.half_size_m = 2000.0;
+  const ElevationRaster part = readElevation(dataPath("zion_srtm.tif"), options);
+  EXPECT_GE(part.width, 54 + 4);
+  EXPECT_LE(part.width, 55 + 4 + 2);
+  EXPECT_GE(part.height, 43 + 4);
+  EXPECT_LE(part.height, 44 + 4 + 2);
+  const PixelPoint origin = whole.georef.pixelFromCrs(part.georef.crsFromPixel({0, 0}));
+  EXPECT_NEAR(origin.col, std::round(origin.col), 1e-9);
+  EXPECT_NEAR(origin.row, std::round(origin.row), 1e-9);
+  for (int row = 0; row < part.height; ++row) {
+    for (int col = 0; col < part.width; ++col) {
+      ASSERT_EQ(part.at(col, row), whole.at(col + static_cast<int>(std::lround(origin.col)),
+                                            row + static_cast<int>(std::lround(origin.row))));
+    }
+  }
+  EXPECT_TRUE(part.heightAt(options.region.centre).has_value());
+
+  // Read 3.5 x as coarse as the pixels are wide: every sample is the mean of
+  // a 3 x 3 block of the file's pixels, rounded to the file's whole metres
+  // (GDAL averages in the samples' type, as overviews of it are).
+  options.region.resolution_m = 3.5 * whole.georef.groundPixelSize(465, 457).col_m;
+  const ElevationRaster coarse = readElevation(dataPath("zion_srtm.tif"), options);
+  EXPECT_NEAR(coarse.width, part.width / 3.0, 1.0);
+  EXPECT_NEAR(coarse.height, part.height / 3.0, 1.0);
+  EXPECT_NEAR(coarse.georef.pixel_dx, 3.0 * whole.georef.pixel_dx, 1e-15);
+  EXPECT_NEAR(coarse.georef.pixel_dy, 3.0 * whole.georef.pixel_dy, 1e-15);
+  const PixelPoint first = whole.georef.pixelFromCrs(coarse.georef.crsFromPixel({-0.5, -0.5}));
+  const int c0 = static_cast<int>(std::lround(first.col + 0.5));
+  const int r0 = static_cast<int>(std::lround(first.row + 0.5));
+  for (const auto& [col, row] : std::vector<std::pair<int, int>>{{0, 0}, {5, 7}, {12, 3}}) {
+    double block_sum = 0.0;
+    for (int dr = 0; dr < 3; ++dr) {
+      for (int dc = 0; dc < 3; ++dc) block_sum += whole.at(c0 + 3 * col + dc, r0 + 3 * row + dr);
+    }
+    EXPECT_NEAR(coarse.at(col, row), block_sum / 9.0, 0.5) << col << ", " << row;
+  }
+
+  options.region.centre = core::geodeticFromDegrees(10.0, 10.0, 0.0);
+  expectTerrainError([&] { readElevation(dataPath("zion_srtm.tif"), options); },
+                     dataPath("zion_srtm.tif"), "outside the raster");
+}
+
+TEST(GdalTerrain, Nad83UtmDem) {
+  // A 3 x 2 DEM in NAD83 / UTM 12N (EPSG:26912, as USGS 3DEP tiles come),
+  // 10 m pixels, heights 100 + col + 10 row: read with its CRS; the height
+  // under the geodetic position of pixel (2, 1)'s centre is that pixel's.
+  cv::Mat heights(2, 3, CV_32F);
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 3; ++col) heights.at<float>(row, col) = 100.0f + col + 10.0f * row;
+  }
+  const std::string path = tempPath("nad83_utm12.tif");
+  writeGeoTiff(path, heights, {10, 10, 0}, {0, 0, 0, 320000, 4130000, 0},
+               geoKeys({{1024, 1}, {1025, 1}, {3072, 26912}}));
+  const ElevationRaster dem = readElevation(path);
+  EXPECT_EQ(dem.georef.crs.epsg(), 26912);
+  EXPECT_EQ(dem.georef.crs.name(), "EPSG:26912 (NAD83 / UTM zone 12N)");
+  const core::Geodetic centre = dem.georef.geodeticFromPixel({2, 1});
+  EXPECT_NEAR(centre.lat_rad * kDegPerRad, 37.3, 0.05);
+  EXPECT_NEAR(*dem.heightAt(centre), 112.0, 1e-6);
+  // The same place in WGS-84 UTM 12N is within the datums' 1-2 m.
+  const CrsPoint utm = Crs::utm(12, true).fromGeodetic(centre);
+  EXPECT_LT(std::hypot(utm.x - 320025.0, utm.y - 4129985.0), 3.0);
+}
+
+TEST(GdalTerrain, AsciiGridCrsFromItsPrj) {
+  // An ESRI grid with a .prj beside it (ESRI WKT of NAD83 / UTM 12N) is in
+  // that CRS; without one, in the CRS given for grids naming none.
+  const std::string grid = test::tempFolderPath("with_prj.asc");
+  writeText(grid, "ncols 2\nnrows 1\nxllcorner 320000\nyllcorner 4130000\ncellsize 30\n7 8\n");
+  writeText(test::tempFolderPath("with_prj.prj"),
+            "PROJCS[\"NAD_1983_UTM_Zone_12N\",GEOGCS[\"GCS_North_American_1983\","
+            "DATUM[\"D_North_American_1983\",SPHEROID[\"GRS_1980\",6378137.0,298.257222101]],"
+            "PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],"
+            "PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],"
+            "PARAMETER[\"False_Northing\",0.0],PARAMETER[\"Central_Meridian\",-111.0],"
+            "PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\",0.0],"
+            "UNIT[\"Meter\",1.0]]");
+  const ElevationRaster dem = readElevation(grid);
+  EXPECT_EQ(dem.georef.crs, Crs::fromEpsg(26912, "test"));
+  EXPECT_EQ(dem.at(1, 0), 8.0f);
+}
+
+// Makes a de_DE.UTF-8 locale (decimal comma) in a folder of the test's own
+// with glibc's localedef and switches to it, as Qt does for a German user.
+class GermanLocale {
+ public:
+  GermanLocale() {
+    const std::string folder = test::tempFolderPath("locales");
+    std::filesystem::create_directories(folder);
+    const std::string command = "localedef -i de_DE -f UTF-8 '" + folder + "/de_DE.UTF-8' 2>&1";
+    made_ = std::system(command.c_str()) == 0;
+    setenv("LOCPATH", folder.c_str(), 1);
+    made_ = made_ && std::setlocale(LC_ALL, "de_DE.UTF-8") != nullptr;
+  }
+  ~GermanLocale() {
+    std::setlocale(LC_ALL, "C");
+    unsetenv("LOCPATH");
+  }
+  bool made() const { return made_; }
+
+ private:
+  bool made_ = false;
+};
+
+TEST(GdalTerrain, NodataIsReadTheSameUnderADecimalCommaLocale) {
+  // A float DEM whose nodata is -3.4028234663852886e+38 (GDAL's usual float
+  // nodata) read under de_DE, where strtod stops at the '.' and reads -3: the
+  // two voids are still voids and are filled from their neighbours (all 50).
+  cv::Mat heights(3, 4, CV_32F, cv::Scalar(50.0f));
+  heights.at<float>(1, 1) = -3.4028234663852886e+38f;
+  heights.at<float>(2, 3) = -3.4028234663852886e+38f;
+  const std::string path = tempPath("float_nodata.tif");
+  writeGeoTiff(path, heights, {0.1, 0.1, 0}, {0, 0, 0, 10, 20, 0}, geographicKeys(),
+               "-3.4028234663852886e+38");
+  const GermanLocale german;
+  ASSERT_TRUE(german.made()) << "localedef could not make de_DE.UTF-8 (package locales)";
+  char text[16];
+  std::snprintf(text, sizeof(text), "%.1f", 2.5);
+  ASSERT_EQ(std::string(text), "2,5");  // the locale is really in force
+  const ElevationRaster dem = readElevation(path);
+  EXPECT_EQ(dem.filled_voids, 2);
+  for (const float h : dem.height_m) EXPECT_EQ(h, 50.0f);
+}
+
+TEST(GdalTerrain, GeoidHeightsBecomeEllipsoidHeights) {
+  // With Debian's EGM96 grid (proj-data), h = H + N. N at (0 N, 0 E) is the
+  // often-quoted 17.16 m; over Zion N is about -22 m, and at each sample
+  // nadir's N matches PROJ's own EGM96 conversion (EPSG:9707 -> 4979, its
+  // own interpolation of the grid) to a centimetre.
+  const std::string egm96 = "/usr/share/proj/egm96_15.gtx";
+  ASSERT_TRUE(std::filesystem::exists(egm96)) << "package proj-data";
+  cv::Mat flat(3, 3, CV_32F, cv::Scalar(0.0f));
+  const std::string null_island = tempPath("null_island.tif");
+  writeGeoTiff(null_island, flat, {0.01, 0.01, 0}, {0, 0, 0, -0.015, 0.015, 0}, geographicKeys());
+  ElevationReadOptions options;
+  options.geoid_path = egm96;
+  const ElevationRaster island = readElevation(null_island, options);
+  EXPECT_NEAR(island.at(1, 1), 17.16, 0.01);
+  EXPECT_EQ(island.geoid_source, egm96);
+
+  const ElevationRaster plain = readElevation(dataPath("zion_srtm.tif"));
+  const ElevationRaster lifted = readElevation(dataPath("zion_srtm.tif"), options);
+  EXPECT_GT(lifted.geoid_min_m, -25.0);
+  EXPECT_LT(lifted.geoid_max_m, -19.0);
+  for (const auto& [col, row] :
+       std::vector<std::pair<int, int>>{{0, 0}, {464, 456}, {200, 300}, {17, 33}}) {
+    const core::Geodetic at = plain.georef.geodeticFromPixel({double(col), double(row)});
+    const double proj_n_m =
+        test::egm96Undulation_m(at.lat_rad * kDegPerRad, at.lon_rad * kDegPerRad);
+    EXPECT_NEAR(lifted.at(col, row) - plain.at(col, row), proj_n_m, 0.01) << col << ", " << row;
+  }
+
+  const std::string far_away = tempPath("not_a_geoid.tif");
+  writeGeoTiff(far_away, flat, {0.01, 0.01, 0}, {0, 0, 0, 50, 50, 0}, geographicKeys());
+  options.geoid_path = far_away;
+  expectTerrainError([&] { readElevation(null_island, options); }, far_away, "outside the raster");
 }
 
 }  // namespace

@@ -75,7 +75,7 @@ const core::Geodetic kZionOrigin = core::geodeticFromDegrees(37.32, -113.05, 0.0
 
 GeoWorld zionWorld(const core::Geodetic& origin = kZionOrigin) {
   return GeoWorld(readElevation(dataPath("zion_srtm.tif")),
-                  readGeoTiffBands(dataPath("zion_landsat_b4.tif"), dataPath("zion_landsat_b3.tif"),
+                  readImageryBands(dataPath("zion_landsat_b4.tif"), dataPath("zion_landsat_b3.tif"),
                                    dataPath("zion_landsat_b2.tif")),
                   core::LocalNedFrame(origin));
 }
@@ -160,7 +160,7 @@ TEST(GeoWorld, ZionExtentAndResolutions) {
   const GeoWorld world = zionWorld();
   const WorldExtent extent = world.extent();
   const ElevationRaster& dem = world.elevation();
-  const GeoTiffInfo landsat = readGeoTiffInfo(dataPath("zion_landsat_b2.tif"));
+  const RasterInfo landsat = readRasterInfo(dataPath("zion_landsat_b2.tif"));
   for (const double north_m : {extent.north_min_m, extent.north_max_m}) {
     for (const double east_m : {extent.east_min_m, extent.east_max_m}) {
       const core::Geodetic g = world.frame().geodeticFromNed({north_m, east_m, 0.0});

@@ -31,7 +31,7 @@ constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 std::vector<uint16_t> geographicKeys() { return geoKeys({{1024, 2}, {1025, 1}, {2048, 4326}}); }
 
 ImageryRaster readLandsat() {
-  return readGeoTiffBands(dataPath("zion_landsat_b4.tif"), dataPath("zion_landsat_b3.tif"),
+  return readImageryBands(dataPath("zion_landsat_b4.tif"), dataPath("zion_landsat_b3.tif"),
                           dataPath("zion_landsat_b2.tif"));
 }
 
@@ -39,11 +39,11 @@ TEST(Landsat, BandsAreUtm12NorthThirtyMetres) {
   // Every band: EPSG:32612, 1128 x 1428, 30 m pixels, corner of pixel (0,0)
   // at E 301905, N 4154085 (the file's tiepoint, PixelIsArea).
   for (const char* band : {"zion_landsat_b2.tif", "zion_landsat_b3.tif", "zion_landsat_b4.tif"}) {
-    const GeoTiffInfo info = readGeoTiffInfo(dataPath(band));
+    const RasterInfo info = readRasterInfo(dataPath(band));
     EXPECT_EQ(info.georef.crs, Crs::utm(12, true)) << band;
     EXPECT_EQ(info.width, 1128);
     EXPECT_EQ(info.height, 1428);
-    EXPECT_EQ(info.bits_per_sample, 16);
+    EXPECT_EQ(info.depth, CV_16U);
     EXPECT_DOUBLE_EQ(info.georef.pixel_dx, 30.0);
     EXPECT_DOUBLE_EQ(info.georef.pixel_dy, -30.0);
     EXPECT_DOUBLE_EQ(info.georef.corner_x, 301905.0);
@@ -114,7 +114,7 @@ TEST(GeoTiffRgb, EightBitKeepsValuesRedFirst) {
   }
   const std::string path = tempPath("rgb8.tif");
   writeGeoTiff(path, rgb, {0.1, 0.1, 0}, {0, 0, 0, 5, 50, 0}, geographicKeys());
-  const ImageryRaster imagery = readGeoTiffRgb(path);
+  const ImageryRaster imagery = readImageryRgb(path);
   ASSERT_EQ(imagery.rgb.type(), CV_8UC3);
   EXPECT_EQ(cv::norm(imagery.rgb, rgb, cv::NORM_INF), 0.0);
   EXPECT_DOUBLE_EQ(imagery.georef.corner_x, 5.0);
@@ -129,7 +129,7 @@ TEST(GeoTiffRgb, SixteenBitIsStretched) {
   rgb.at<cv::Vec<uint16_t, 3>>(0, 2) = {2000, 700, 40200};
   const std::string path = tempPath("rgb16.tif");
   writeGeoTiff(path, rgb, {0.1, 0.1, 0}, {0, 0, 0, 5, 50, 0}, geographicKeys());
-  const ImageryRaster imagery = readGeoTiffRgb(path, {.low_percent = 0, .high_percent = 100});
+  const ImageryRaster imagery = readImageryRgb(path, {}, {.low_percent = 0, .high_percent = 100});
   EXPECT_EQ(imagery.rgb.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
   EXPECT_EQ(imagery.rgb.at<cv::Vec3b>(0, 1), cv::Vec3b(51, 51, 51));
   EXPECT_EQ(imagery.rgb.at<cv::Vec3b>(0, 2), cv::Vec3b(255, 255, 255));
@@ -150,14 +150,14 @@ TEST(GeoTiffBands, DifferentGridsAreAnErrorNamingTheFiles) {
                geoKeys({{1024, 1}, {1025, 1}, {3072, 32612}}));
   for (const std::string& other : {b, c}) {
     try {
-      readGeoTiffBands(a, a, other);
+      readImageryBands(a, a, other);
       ADD_FAILURE() << "no exception";
     } catch (const TerrainError& e) {
       EXPECT_NE(std::string(e.what()).find(a), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find(other), std::string::npos) << e.what();
     }
   }
-  EXPECT_NO_THROW(readGeoTiffBands(a, a, a));
+  EXPECT_NO_THROW(readImageryBands(a, a, a));
 }
 
 TEST(PlainImage, CornersGiveGeoreferenceAndNorthIsUp) {
@@ -241,8 +241,8 @@ TEST(Stretch, BadPercentilesAreAnError) {
   const std::string path = tempPath("rgb8_again.tif");
   writeGeoTiff(path, cv::Mat(2, 2, CV_16UC3, cv::Scalar(1, 2, 3)), {0.1, 0.1, 0},
                {0, 0, 0, 5, 50, 0}, geographicKeys());
-  EXPECT_THROW(readGeoTiffRgb(path, {.low_percent = 50, .high_percent = 50}), TerrainError);
-  EXPECT_THROW(readGeoTiffRgb(path, {.low_percent = -1, .high_percent = 50}), TerrainError);
+  EXPECT_THROW(readImageryRgb(path, {}, {.low_percent = 50, .high_percent = 50}), TerrainError);
+  EXPECT_THROW(readImageryRgb(path, {}, {.low_percent = -1, .high_percent = 50}), TerrainError);
 }
 
 }  // namespace

@@ -1,10 +1,12 @@
 #include "terrain_test_util.h"
 #include <gtest/gtest.h>
+#include <ogr_spatialref.h>
 #include <tiffio.h>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <string>
@@ -17,6 +19,29 @@ namespace test {
 
 std::string tempPath(const std::string& name) {
   return (std::filesystem::path(::testing::TempDir()) / ("nadir_terrain_" + name)).string();
+}
+
+std::string tempFolderPath(const std::string& name) {
+  const std::filesystem::path folder =
+      std::filesystem::path(::testing::TempDir()) / "nadir_terrain";
+  std::filesystem::create_directories(folder);
+  return (folder / name).string();
+}
+
+double egm96Undulation_m(double lat_deg, double lon_deg) {
+  OGRSpatialReference geoid_heights;
+  OGRSpatialReference ellipsoid_heights;
+  geoid_heights.importFromEPSG(9707);
+  ellipsoid_heights.importFromEPSG(4979);
+  geoid_heights.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  ellipsoid_heights.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const std::unique_ptr<OGRCoordinateTransformation> to_ellipsoid(
+      OGRCreateCoordinateTransformation(&geoid_heights, &ellipsoid_heights));
+  double x = lon_deg, y = lat_deg, z = 0.0;
+  if (!to_ellipsoid || !to_ellipsoid->Transform(1, &x, &y, &z)) {
+    ADD_FAILURE() << "PROJ cannot convert EGM96 heights at " << lat_deg << ", " << lon_deg;
+  }
+  return z;
 }
 
 std::string dataPath(const std::string& name) {

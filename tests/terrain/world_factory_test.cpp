@@ -45,6 +45,37 @@ TEST(WorldFactory, FilesWorldCentresOnTheDem) {
   EXPECT_NEAR(built.world->imageryResolution_m(), 30.0, 1.0);
 }
 
+// A files world read as a 6 km square around a given origin, through the
+// EGM96 geoid: the world reaches about 3 km each way (not Zion's whole 34 x
+// 42 km), the origin is where it was given, and ground heights are the DEM's
+// plus EGM96's -22.5 m or so there.
+TEST(WorldFactory, FilesWorldWindowAroundAGivenOriginWithAGeoid) {
+  WorldParams params;
+  params.kind = "files";
+  params.dem_path = test::dataPath("zion_srtm.tif");
+  params.origin_lat_deg = 37.3;
+  params.origin_lon_deg = -113.0;
+  params.origin_alt_m = 1500.0;
+  params.origin_at_dem_centre = false;
+  params.extent_m = 3000.0;
+  const BuiltWorld plain = makeWorld(params);
+  EXPECT_NEAR(plain.origin.lat_rad / kDeg, 37.3, 1e-12);
+  const WorldExtent extent = plain.world->extent();
+  EXPECT_GT(extent.north_max_m, 3000.0);
+  EXPECT_LT(extent.north_max_m, 3000.0 + 4 * 93.0);
+  EXPECT_LT(extent.east_min_m, -3000.0);
+  EXPECT_GT(extent.east_min_m, -3000.0 - 4 * 74.0);
+
+  params.geoid_file = "/usr/share/proj/egm96_15.gtx";
+  const BuiltWorld lifted = makeWorld(params);
+  for (const double north_m : {-2000.0, 0.0, 2500.0}) {
+    const double n_m =
+        lifted.world->groundUp_m(north_m, 100.0) - plain.world->groundUp_m(north_m, 100.0);
+    EXPECT_NEAR(n_m, test::egm96Undulation_m(37.3 + north_m / 111000.0, -113.0 + 100.0 / 88600.0),
+                0.05);
+  }
+}
+
 // A files world without a DEM, or with a missing one, is refused naming what is wrong.
 TEST(WorldFactory, FilesWorldNeedsAReadableDem) {
   WorldParams params;
