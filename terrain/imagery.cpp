@@ -10,6 +10,8 @@
 #include <fstream>
 #include <vector>
 
+#include "terrain/gdal_support.h"
+
 namespace nadir::terrain {
 namespace {
 
@@ -185,6 +187,8 @@ ImageryRaster readImageWithBounds(const std::string& path, const LatLonBounds& b
         std::to_string(bounds.east_deg) + " deg)");
   }
   cv::Mat bgr;
+  // OpenCV tries GDAL on what its own decoders refuse; its words go in the error.
+  const GdalErrors errors;
   try {
     bgr = cv::imread(path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
@@ -193,7 +197,8 @@ ImageryRaster readImageWithBounds(const std::string& path, const LatLonBounds& b
   if (bgr.empty()) {
     const std::string content = describeFileContent(path);
     throw TerrainError(path + ": OpenCV cannot decode it as an image" +
-                       (content.empty() ? std::string() : " (it is " + content + ")"));
+                       (content.empty() ? std::string() : " (it is " + content + ")") +
+                       errors.said());
   }
   ImageryRaster imagery;
   cv::cvtColor(bgr, imagery.rgb, cv::COLOR_BGR2RGB);
