@@ -237,11 +237,13 @@ void GpsParams::visit(core::ParamVisitor& v) {
   }
 }
 
-GpsModel::GpsModel(const GpsParams& params)
-    : params_(validated(params, "gps")), noise_(static_cast<std::uint64_t>(params_.seed)) {}
+GpsModel::GpsModel(const GpsParams& params, std::int64_t start_utime)
+    : params_(validated(params, "gps")),
+      start_utime_(start_utime),
+      noise_(static_cast<std::uint64_t>(params_.seed)) {}
 
 bool GpsModel::inOutage(std::int64_t utime) const {
-  const double t_s = static_cast<double>(utime) * 1e-6;
+  const double t_s = static_cast<double>(utime - start_utime_) * 1e-6;
   if (params_.denied_after_s >= 0.0 && t_s >= params_.denied_after_s) return true;
   for (std::size_t i = 0; i + 1 < params_.outages_s.size(); i += 2) {
     if (t_s >= params_.outages_s[i] && t_s < params_.outages_s[i + 1]) return true;

@@ -164,18 +164,20 @@ using GpsSample = msg::Gps;
 // Position (white noise in metres, north/east with horizontal_sigma_m, down
 // with vertical_sigma_m, converted exactly with the LocalNedFrame) and NED
 // velocity with white noise. Inside an outage window (start_s <= t < end_s,
-// t = utime / 1e6) and from denied_after_s on, the fix is NONE and the other
-// fields are zero.
+// t the seconds since start_utime, the run's first instant: 0 for a
+// simulated flight, a replayed real flight's own first time stamp) and from
+// denied_after_s on, the fix is NONE and the other fields are zero.
 class GpsModel {
  public:
   // Throws core::ParamError if a parameter is invalid.
-  explicit GpsModel(const GpsParams& params);
+  explicit GpsModel(const GpsParams& params, std::int64_t start_utime = 0);
 
   GpsSample sample(const VehicleState& state, const core::LocalNedFrame& frame);
   bool inOutage(std::int64_t utime) const;
 
  private:
   GpsParams params_;
+  std::int64_t start_utime_ = 0;
   GaussianNoise noise_;
 };
 

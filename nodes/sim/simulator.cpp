@@ -119,7 +119,7 @@ Simulator::Simulator(const SimParams& params, std::shared_ptr<const terrain::Wor
   const SensorsParams& sensors = params_.sensors;
   if (sensors.imu.enabled) imu_.emplace(sensors.imu.model);
   if (sensors.rangefinder.enabled) rangefinder_.emplace(sensors.rangefinder.model);
-  if (sensors.gps.enabled) gps_.emplace(sensors.gps.model);
+  if (sensors.gps.enabled) gps_.emplace(sensors.gps.model, start_utime_);
   if (sensors.barometer.enabled) barometer_.emplace(sensors.barometer.model);
   if (sensors.magnetometer.enabled) magnetometer_.emplace(sensors.magnetometer.model);
   if (!sensors.ahrs.ideal()) {
@@ -210,7 +210,7 @@ bool Simulator::guidanceOnSource(std::int64_t utime) const {
   if (source == "truth" || flight_ || external_) return false;
   if (source == "gps") return true;
   const double denied_s = params_.sensors.gps.model.denied_after_s;
-  return denied_s < 0.0 || core::secondsFromUtime(utime) >= denied_s;
+  return denied_s < 0.0 || core::secondsFromUtime(utime - start_utime_) >= denied_s;
 }
 
 std::string Simulator::guidanceSource() const {

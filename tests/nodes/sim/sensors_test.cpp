@@ -439,6 +439,26 @@ TEST(GpsModel, OutageWindow) {
   EXPECT_EQ(none.num_satellites, 0);
 }
 
+// A replayed real flight starts at its own time stamp (here 2023-11-14
+// 22:13:20 UTC, 1.7e15 us): outage windows and the denial count from there,
+// not from 1970 (which would deny every fix of a real flight).
+TEST(GpsModel, WindowsCountFromTheRunsStart) {
+  const core::LocalNedFrame frame(core::geodeticFromDegrees(44.0, -71.0, 200.0));
+  constexpr std::int64_t kStart_us = 1'700'000'000'000'000;
+  GpsParams params;
+  params.outages_s = {10.0, 20.0};
+  params.denied_after_s = 40.0;
+  GpsModel gps(params, kStart_us);
+  const auto fixAt = [&](double t_s) {
+    return gps.sample(stateAt(kStart_us + std::llround(t_s * 1e6)), frame).fix;
+  };
+  EXPECT_EQ(fixAt(0.0), GpsFix::FIX_3D);
+  EXPECT_EQ(fixAt(15.0), GpsFix::NONE);
+  EXPECT_EQ(fixAt(25.0), GpsFix::FIX_3D);
+  EXPECT_EQ(fixAt(39.8), GpsFix::FIX_3D);
+  EXPECT_EQ(fixAt(40.0), GpsFix::NONE);
+}
+
 // An odd-length outage list (or a window ending before it starts) fails validation.
 TEST(GpsModel, OutageListValidated) {
   GpsParams params;
