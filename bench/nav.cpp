@@ -73,7 +73,12 @@ int main(int argc, char** argv) {
                             channel == params.vo_channel || channel == params.truth_channel ||
                             channel == params.gps_channel;
         if (!wanted) continue;
-        if (channel == params.gps_channel && event->timestamp_utime >= denied_utime) continue;
+        // The message's own (sim) time: a log's event times may count from a date.
+        const nadir::core::RawMessage raw{channel, event->data.data(), event->data.size(), 0};
+        if (channel == params.gps_channel &&
+            nadir::core::peekUtime(raw).value_or(event->timestamp_utime) >= denied_utime) {
+          continue;
+        }
         events.push_back(std::move(*event));
       }
     }

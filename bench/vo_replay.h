@@ -81,7 +81,11 @@ class VoReplay {
     while (auto event = reader.next()) {
       if (event->channel == image_channel_) {
         saw_images = true;
-        if (!first_image_utime_) first_image_utime_ = event->timestamp_utime;
+        if (!first_image_utime_) {
+          // The image's own (sim) time, what the debug image is compared with.
+          const core::RawMessage raw{event->channel, event->data.data(), event->data.size(), 0};
+          first_image_utime_ = core::peekUtime(raw).value_or(event->timestamp_utime);
+        }
       }
       bus_->publish(event->channel, event->data.data(), event->data.size(), event->timestamp_utime);
       bus_->handleAvailable();

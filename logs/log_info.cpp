@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/clock.h"
+#include "core/utc_time.h"
 
 namespace nadir::logs {
 namespace {
@@ -55,6 +56,11 @@ std::string table(const std::vector<std::vector<std::string>>& rows, const std::
     out += line + "\n";
   }
   return out;
+}
+
+// ", from 2024-06-21T10:00:00Z" for a time that is a date (after 2000), else "".
+std::string fromDate(std::int64_t utime) {
+  return utime >= core::kYear2000Utime ? ", from " + core::utcFromUtime(utime) : std::string();
 }
 
 }  // namespace
@@ -132,15 +138,16 @@ std::string formatLogInfo(const LogInfo& info) {
       << formatted("%.3f", info.duration_s) << " s\n";
   if (info.events > 0) {
     out << "  event time    " << absoluteSeconds(info.start_utime) << " .. "
-        << absoluteSeconds(info.end_utime) << " s (" << formatted("%.3f", info.duration_s)
-        << " s)\n";
+        << absoluteSeconds(info.end_utime) << " s (" << formatted("%.3f", info.duration_s) << " s)"
+        << fromDate(info.start_utime) << "\n";
   }
   if (info.messages_with_utime > 0) {
     out << "  message time  " << absoluteSeconds(info.message_min_utime) << " .. "
         << absoluteSeconds(info.message_max_utime) << " s ("
         << formatted("%.3f",
                      core::secondsFromUtime(info.message_max_utime - info.message_min_utime))
-        << " s), the leading utime of " << info.messages_with_utime << " messages\n";
+        << " s), the leading utime of " << info.messages_with_utime << " messages"
+        << fromDate(info.message_min_utime) << "\n";
   }
   if (info.backward_steps > 0) {
     out << "  note: the event time goes backwards " << info.backward_steps

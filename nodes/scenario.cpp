@@ -3,9 +3,14 @@
 #include "nodes/nav/nav_node.h"
 #include "nodes/registry.h"
 
+#include "core/sun.h"
+#include "core/utc_time.h"
+
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
@@ -18,6 +23,45 @@ namespace fs = std::filesystem;
 void resolveRelative(std::string& path, const fs::path& folder) {
   if (path.empty() || fs::path(path).is_absolute()) return;
   path = (folder / path).lexically_normal().string();
+}
+
+// An empty time.start_utc becomes kDefaultStartDate at 10:00 local mean solar
+// time at the origin; over the procedural world, the sun's angles not given
+// become where the sun stands at the origin then.
+void resolveStartAndSun(ScenarioParams& params, const std::vector<std::string>& given) {
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  const auto is_given = [&given](std::string_view key) {
+    return std::find(given.begin(), given.end(), key) != given.end();
+  };
+  std::optional<core::Geodetic> origin;
+  const auto origin_deg = [&]() {
+    if (!origin) origin = terrain::approximateOrigin(params.world);
+    return std::pair{origin->lat_rad * kDeg, origin->lon_rad * kDeg};
+  };
+  if (params.time.start_utc.empty()) {
+    const std::int64_t midnight =
+        core::utimeFromUtc(std::string(sim::kDefaultStartDate) + "T00:00:00Z");
+    const double hours = 10.0 - origin_deg().second / 15.0;
+    params.time.start_utc = core::utcFromUtime(midnight + std::llround(hours * 3600.0) * 1'000'000);
+  }
+  const std::int64_t start_utime = sim::runStartUtime(params.time);
+  if (params.world.kind != "procedural" || is_given("world.procedural.sun_azimuth_deg") ||
+      is_given("world.procedural.sun_elevation_deg")) {
+    return;
+  }
+  const auto [lat_deg, lon_deg] = origin_deg();
+  const core::SunPosition sun = core::sunPosition(start_utime, lat_deg, lon_deg);
+  constexpr double kLowestSun_deg = 15.0;
+  if (sun.elevation_deg < kLowestSun_deg) {
+    throw core::ParamError(
+        "time.start_utc " + params.time.start_utc + ": the sun is " +
+        std::to_string(sun.elevation_deg) +
+        " deg above the horizon at the origin; the "
+        "procedural world is lit from at least 15 deg: choose a time of day or give "
+        "world.procedural.sun_azimuth_deg and sun_elevation_deg");
+  }
+  params.world.procedural.sun_azimuth_deg = sun.azimuth_deg;
+  params.world.procedural.sun_elevation_deg = sun.elevation_deg;
 }
 
 }  // namespace
@@ -96,7 +140,9 @@ ScenarioParams loadScenario(const std::string& name_or_path,
   resolveRelative(params.camera.calibration_file, folder);
   for (auto& [name, spec] : params.cameras) resolveRelative(spec.calibration_file, folder);
   core::applyAssignments(params, overrides);
-  terrain::markGivenOrigin(params.world, core::givenKeys(path, overrides));
+  const std::vector<std::string> given = core::givenKeys(path, overrides);
+  terrain::markGivenOrigin(params.world, given);
+  resolveStartAndSun(params, given);
   // The guidance's source is a navigation choice, under nav in a scenario.
   params.sim.guidance.source = params.node<nav::NavNodeParams>("nav").source;
   return params;

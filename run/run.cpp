@@ -84,13 +84,19 @@ RunResult runScenario(const RunOptions& options,
       }
     }
   }
-  core::Subscription recorder =
-      bus->subscribe(".*", [&log, &result, &unrecorded](const core::RawMessage& raw) {
-        ++result.totals.messages;
-        const std::string channel(raw.channel);
-        if (unrecorded.count(channel) != 0) return;
-        log.write(core::peekUtime(raw).value_or(0), channel, raw.data, raw.size);
-      });
+  // Event times are the messages' own plus the offset that puts the run's
+  // sim time 0 on time.start_utc, so that LCM's tools show the scenario's
+  // date; a replayed real flight's messages already carry theirs.
+  const std::int64_t start_utime = sim::runStartUtime(scenario.time);
+  std::optional<std::int64_t> event_offset_us;
+  core::Subscription recorder = bus->subscribe(".*", [&](const core::RawMessage& raw) {
+    ++result.totals.messages;
+    const std::string channel(raw.channel);
+    if (unrecorded.count(channel) != 0) return;
+    const std::int64_t utime = core::peekUtime(raw).value_or(0);
+    if (!event_offset_us) event_offset_us = sim::logEventOffset_us(start_utime, utime);
+    log.write(utime + *event_offset_us, channel, raw.data, raw.size);
+  });
 
   // The simulator and the camera make the world (the camera's world serves both);
   // the processing nodes come from the registry.

@@ -139,6 +139,17 @@ BuiltWorld makeWorld(const WorldParams& params) {
   return built;
 }
 
+core::Geodetic approximateOrigin(const WorldParams& params) {
+  if (params.kind == "files" && params.origin_at_dem_centre) {
+    const RasterInfo info = readRasterInfo(
+        params.dem_path, Crs::fromDefinition(params.default_crs, "world.default_crs"));
+    return info.georef.geodeticFromPixel({0.5 * (info.width - 1), 0.5 * (info.height - 1)},
+                                         params.origin_alt_m);
+  }
+  return core::geodeticFromDegrees(params.origin_lat_deg, params.origin_lon_deg,
+                                   params.origin_alt_m);
+}
+
 void markGivenOrigin(WorldParams& params, const std::vector<std::string>& given_keys,
                      const std::string& prefix) {
   const auto given = [&](const std::string& key) {

@@ -65,6 +65,10 @@ struct BuiltWorld {
 // Throws TerrainError (files) or core::ParamError (bad values) naming what is wrong.
 BuiltWorld makeWorld(const WorldParams& params);
 
+// The origin's latitude and longitude as makeWorld will put it, reading no
+// more of a DEM than its header (the height is origin_alt_m).
+core::Geodetic approximateOrigin(const WorldParams& params);
+
 // Throws std::invalid_argument when the world is not ground to fly or drive
 // over (a checkerboard world is a calibration board a few decimetres across:
 // nadir calib --virtual looks at it).

@@ -1,5 +1,10 @@
 #include "nodes/sim/sim_params.h"
 
+#include <stdexcept>
+#include <string>
+
+#include "core/utc_time.h"
+
 namespace nadir::sim {
 
 void VehicleParams::visit(core::ParamVisitor& v) {
@@ -104,6 +109,23 @@ void TimeParams::visit(core::ParamVisitor& v) {
           {.doc = "realtime (paced at speed x real time) or batch (as fast as possible)",
            .choices = {"realtime", "batch"}});
   v.field("speed", &speed, {.doc = "realtime: multiple of real time", .min = 0.01, .max = 1000});
+  v.field("start_utc", &start_utc,
+          {.doc = "the run's first instant, UTC, e.g. 2024-06-21T10:00:00Z (log times, the "
+                  "procedural sun); empty: 2024-06-21 at 10:00 local solar time at the origin"});
+}
+
+std::int64_t runStartUtime(const TimeParams& time) {
+  const std::string text =
+      time.start_utc.empty() ? std::string(kDefaultStartDate) + "T10:00:00Z" : time.start_utc;
+  try {
+    return core::utimeFromUtc(text);
+  } catch (const std::invalid_argument& e) {
+    throw core::ParamError("time.start_utc: " + std::string(e.what()));
+  }
+}
+
+std::int64_t logEventOffset_us(std::int64_t start_utime, std::int64_t first_message_utime) {
+  return first_message_utime >= core::kYear2000Utime ? 0 : start_utime;
 }
 
 void SimNodeParams::visit(core::ParamVisitor& v) {

@@ -161,13 +161,31 @@ struct SimParams {
 };
 
 // How sim time runs when nadir-sim flies live (a batch run is as fast as it can).
+// The date of a scenario that gives none: a long summer day in the north.
+inline constexpr const char* kDefaultStartDate = "2024-06-21";
+
 struct TimeParams {
   // "realtime" paces the streams at speed x real time; "batch" runs as fast as possible.
   std::string mode = "realtime";
   double speed = 1.0;
+  // The run's first instant in UTC ("2024-06-21T10:00:00Z"): what a run's LCM
+  // log's event times count from and, over the procedural world, where the
+  // sun stands. Empty: kDefaultStartDate at 10:00 local solar time at the
+  // origin (loadScenario writes it out).
+  std::string start_utc;
 
   void visit(core::ParamVisitor& v);
 };
+
+// time.start_utc as microseconds since 1970 (kDefaultStartDate at 10:00 UTC
+// when empty, for parameters made in code). Throws core::ParamError for text
+// that is not a UTC date and time.
+std::int64_t runStartUtime(const TimeParams& time);
+
+// What to add to a run's message times to get its log's event times: the
+// start, when the first message's time counts from 0 (a simulated run); 0
+// when it is already a date (after 2000-01-01: a replayed real flight).
+std::int64_t logEventOffset_us(std::int64_t start_utime, std::int64_t first_message_utime);
 
 // What the nadir-sim process reads: the simulator's keys at the top level, as in
 // a scenario, with the world it flies over and how time runs.

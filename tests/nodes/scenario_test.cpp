@@ -477,6 +477,42 @@ TEST(Scenario, AGivenOriginIsUsedForAFilesWorld) {
   EXPECT_NEAR(both.lat_rad / kDeg, 37.3225, 1e-3);
 }
 
+// A scenario without a start time starts on 2024-06-21 at 10:00 local mean
+// solar time at its origin (47 N, 8 E: 10:00 - 8 / 15 h = 09:28 UTC), and the
+// procedural world's sun stands where it is then: hour angle -30 deg minus the
+// equation of time's 0.4 deg, declination 23.44 deg, so elevation
+// asin(sin 47 sin 23.44 + cos 47 cos 23.44 cos 30.4) = 56.16 deg and azimuth
+// 123.5 deg (worked out by hand). Given sun angles are kept; a start at night
+// or text that is no UTC time is refused naming time.start_utc.
+TEST(Scenario, StartTimeAndTheSunFromIt) {
+  const std::filesystem::path folder =
+      std::filesystem::path(::testing::TempDir()) / "nadir_scenario_start";
+  std::filesystem::create_directories(folder);
+  const std::string path = (folder / "alps.yaml").string();
+  std::ofstream(path) << "world:\n  kind: procedural\n  origin_lat_deg: 47\n  origin_lon_deg: 8\n";
+  const ScenarioParams alps = loadScenario(path);
+  EXPECT_EQ(alps.time.start_utc, "2024-06-21T09:28:00Z");
+  EXPECT_NEAR(alps.world.procedural.sun_elevation_deg, 56.16, 0.2);
+  EXPECT_NEAR(alps.world.procedural.sun_azimuth_deg, 123.5, 0.5);
+
+  const ScenarioParams given = loadScenario(path, {"world.procedural.sun_elevation_deg=30"});
+  EXPECT_EQ(given.world.procedural.sun_elevation_deg, 30.0);
+  EXPECT_EQ(given.world.procedural.sun_azimuth_deg, 150.0);
+
+  const ScenarioParams builtin = loadScenario("default");
+  EXPECT_EQ(builtin.world.procedural.sun_azimuth_deg, 150.0);
+  EXPECT_EQ(builtin.world.procedural.sun_elevation_deg, 45.0);
+
+  for (const std::string& start : {std::string("2024-06-21T23:00:00Z"), std::string("yesterday")}) {
+    try {
+      loadScenario(path, {"time.start_utc=" + start});
+      ADD_FAILURE() << start << ": no error";
+    } catch (const core::ParamError& e) {
+      EXPECT_NE(std::string(e.what()).find("time.start_utc"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // A real flight from a CSV comes back out of the POSE_TRUTH stream within the
 // interpolation error: a 200 m circle at 20 m/s sampled at 10 Hz, replayed at 400 Hz.
 TEST(Scenario, FlightCsvRoundTripsThroughTheTruthStream) {

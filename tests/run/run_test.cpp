@@ -14,6 +14,8 @@
 
 #include "core/bus.h"
 #include "core/lcm_log.h"
+#include "core/utc_time.h"
+#include "lcmtypes/codec.h"
 #include "logs/eval/run_metrics.h"
 #include "nodes/scenario.h"
 #include "run/launch.h"
@@ -45,7 +47,9 @@ RunOptions shortRun(const std::string& out_dir) {
 }
 
 // A run writes its log, metrics, truth TUM, pictures and the effective scenario; the
-// log holds the truth at 400 Hz and the camera at 20 frames/s, all at sim time.
+// log holds the truth at 400 Hz and the camera at 20 frames/s, all at sim time,
+// its events at the scenario's date: 2024-06-21 at 10:00 local solar time at
+// 8 deg E, 10:00 - 8 / 15 h = 09:28:00 UTC (written into scenario.yaml).
 TEST(Run, WritesItsFiles) {
   const RunResult result = runScenario(shortRun(tempDir("files")));
   for (const char* name : {"run.lcmlog", "metrics.json", "truth.tum", "tracks.png",
@@ -54,14 +58,22 @@ TEST(Run, WritesItsFiles) {
   }
   std::map<std::string, int> counts;
   core::LcmLogReader reader(result.log_path);
+  std::int64_t last_truth_event_utime = -1;
   std::int64_t last_truth_utime = -1;
   while (auto event = reader.next()) {
     ++counts[event->channel];
-    if (event->channel == "POSE_TRUTH") last_truth_utime = event->timestamp_utime;
+    if (event->channel == "POSE_TRUTH") {
+      last_truth_event_utime = event->timestamp_utime;
+      last_truth_utime = msg::decode<msg::Pose>(event->data).utime;
+    }
   }
   EXPECT_EQ(counts["POSE_TRUTH"], 3 * 400 + 1);
   EXPECT_EQ(counts["CAMERA_DOWN"], 3 * 20 + 1);
   EXPECT_EQ(last_truth_utime, 3'000'000);
+  EXPECT_EQ(last_truth_event_utime, core::utimeFromUtc("2024-06-21T09:28:00Z") + 3'000'000);
+  EXPECT_NE(readFile((fs::path(result.out_dir) / "scenario.yaml").string())
+                .find("start_utc: \"2024-06-21T09:28:00Z\""),
+            std::string::npos);
   EXPECT_NEAR(result.metrics.truth_duration_s, 3.0, 1e-9);
   EXPECT_NEAR(result.metrics.truth_track_length_m, 3.0 * 20.0, 0.5);  // 20 m/s airspeed, no wind
 }
@@ -111,7 +123,9 @@ TEST(Run, RefusesToOverwriteAnEarlierRun) {
   EXPECT_NO_THROW(runScenario(options));
 }
 
-// The run's log replayed through the log bus and recorded again evaluates to the same metrics.
+// The run's log replayed through the log bus and recorded again (each event at
+// the time the log bus gives it, its event time) is the same file and evaluates
+// to the same metrics.
 TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
   const RunResult result = runScenario(shortRun(tempDir("replay")));
   const std::string replayed = (fs::path(result.out_dir) / "replayed.lcmlog").string();
@@ -119,7 +133,7 @@ TEST(Run, ReplayThroughTheLogBusGivesIdenticalMetrics) {
     auto player = core::openBus("file://" + result.log_path + "?mode=r&speed=0");
     core::LcmLogWriter writer(replayed);
     auto recorder = player->subscribe(".*", [&writer](const core::RawMessage& raw) {
-      writer.write(core::peekUtime(raw).value_or(0), std::string(raw.channel), raw.data, raw.size);
+      writer.write(raw.recv_utime, std::string(raw.channel), raw.data, raw.size);
     });
     while (player->handle(std::chrono::milliseconds(0))) {
     }
