@@ -3,7 +3,9 @@
 // content: any format the readers open through GDAL, a VRT among them), or an
 // SRTM tile (.hgt: the input repeated to the size of a 1201 x 1201 tile, so
 // its voids and heights vary). What reads is a whole
-// raster without NaN, and every height asked of it is finite or nothing.
+// raster without NaN, and every height asked of it is finite or nothing. A
+// read through GDAL giving more samples than an SRTM tile holds is refused.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -15,9 +17,17 @@
 
 namespace {
 
+// The input repeated: copied once, then doubled until the tile is full.
 std::string writeHgt(const std::uint8_t* data, std::size_t size) {
   std::vector<std::uint8_t> tile(1201u * 1201u * 2u, 0);
-  for (std::size_t i = 0; i < tile.size() && size > 0; ++i) tile[i] = data[i % size];
+  std::size_t filled = std::min(size, tile.size());
+  std::copy(data, data + filled, tile.begin());
+  while (filled > 0 && filled < tile.size()) {
+    const std::size_t more = std::min(filled, tile.size() - filled);
+    std::copy(tile.begin(), tile.begin() + static_cast<std::ptrdiff_t>(more),
+              tile.begin() + static_cast<std::ptrdiff_t>(filled));
+    filled += more;
+  }
   return nadir::fuzz::writeInput(tile.data(), tile.size(), "N44W072.hgt");
 }
 
@@ -34,7 +44,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                              : kind == 1 ? nadir::fuzz::writeInput(data, size, "input.tif")
                              : kind == 2 ? nadir::fuzz::writeInput(data, size, "input.dem")
                                          : writeHgt(data, size);
-    const ElevationRaster dem = readElevation(path);
+    ElevationReadOptions options;
+    options.region.max_samples = nadir::fuzz::kMaxSamplesRead;
+    const ElevationRaster dem = readElevation(path, options);
     NADIR_FUZZ_REQUIRE(dem.width > 0 && dem.height > 0);
     NADIR_FUZZ_REQUIRE(dem.height_m.size() ==
                        static_cast<std::size_t>(dem.width) * static_cast<std::size_t>(dem.height));

@@ -16,6 +16,14 @@
 
 namespace nadir::fuzz {
 
+// The most samples the dem and imagery targets let a reader give in all the bands
+// it reads (an SRTM tile's). Reading costs time in proportion to the samples a
+// raster declares (about 0.3 us a sample with the sanitizers and libFuzzer's
+// instrumentation) and finds no new path beyond the first blocks, so a few
+// hundred bytes declaring millions of samples would stop a target at its hang
+// limit without a hang (docs/reliability.md).
+inline constexpr std::int64_t kMaxSamplesRead = 1201 * 1201;
+
 // A promise the code under test broke: says which, then aborts (libFuzzer
 // keeps the input, the replay test fails).
 inline void require(bool condition, const char* promise) {

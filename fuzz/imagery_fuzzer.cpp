@@ -1,7 +1,7 @@
 // The imagery readers on any bytes; the first byte picks the reader: an RGB
 // raster (.tif, read by GDAL by content), three single-band rasters (the input as each band), or a
 // plain image with given bounds. What reads is an 8-bit RGB raster whose colours can be asked
-// anywhere.
+// anywhere. A read giving more than kMaxSamplesRead samples in its three bands is refused.
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -17,11 +17,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace nadir::terrain;
   try {
     ImageryRaster imagery;
+    RasterRegion whole;
+    whole.max_samples = nadir::fuzz::kMaxSamplesRead / 3;
     if (kind == 0) {
-      imagery = readImageryRgb(nadir::fuzz::writeInput(data, size, "rgb.tif"));
+      imagery = readImageryRgb(nadir::fuzz::writeInput(data, size, "rgb.tif"), whole);
     } else if (kind == 1) {
       const std::string band = nadir::fuzz::writeInput(data, size, "band.tif");
-      imagery = readImageryBands(band, band, band);
+      imagery = readImageryBands(band, band, band, whole);
     } else {
       imagery = readImageWithBounds(nadir::fuzz::writeInput(data, size, "image.png"),
                                     LatLonBounds{37.5, 37.1, -113.2, -112.8});

@@ -56,10 +56,10 @@ ElevationRaster readSingleBand(const RasterInfo& info, const RasterRegion& regio
   raster.height = window.out_height;
   raster.georef = window.georef;
   raster.source = info.path;
-  raster.height_m.assign(samples.values.begin<float>(), samples.values.end<float>());
-  for (std::size_t i = 0; i < raster.height_m.size(); ++i) {
-    if (samples.valid.data[i] == 0) raster.height_m[i] = kVoid;
-  }
+  cv::Mat heights = samples.values.clone();
+  heights.setTo(kVoid, samples.valid == 0);
+  const auto* first = heights.ptr<float>();
+  raster.height_m.assign(first, first + heights.total());
   return raster;
 }
 

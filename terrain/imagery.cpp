@@ -70,13 +70,18 @@ cv::Mat stretchBand(const cv::Mat& band, const cv::Mat& valid, const StretchPara
   }
   cv::Mat values;
   band.convertTo(values, CV_32F);
+  // Which samples count, as one mask built by whole-raster operations: a raster can
+  // hold 2^28 samples.
+  cv::Mat use;
+  cv::compare(values, values, use, cv::CMP_EQ);
+  if (!valid.empty()) use &= valid != 0;
   std::vector<float> samples;
-  samples.reserve(values.total());
+  samples.reserve(static_cast<std::size_t>(cv::countNonZero(use)));
   for (int row = 0; row < values.rows; ++row) {
     const float* in = values.ptr<float>(row);
-    const unsigned char* ok = valid.empty() ? nullptr : valid.ptr<unsigned char>(row);
+    const unsigned char* ok = use.ptr<unsigned char>(row);
     for (int col = 0; col < values.cols; ++col) {
-      if ((ok == nullptr || ok[col] != 0) && !std::isnan(in[col])) samples.push_back(in[col]);
+      if (ok[col] != 0) samples.push_back(in[col]);
     }
   }
   cv::Mat out(band.size(), CV_8U, cv::Scalar(0));
@@ -93,12 +98,10 @@ cv::Mat stretchBand(const cv::Mat& band, const cv::Mat& valid, const StretchPara
   const double gain = 255.0 / std::max(high - low, 1e-12);
   for (int row = 0; row < values.rows; ++row) {
     const float* in = values.ptr<float>(row);
-    const unsigned char* ok = valid.empty() ? nullptr : valid.ptr<unsigned char>(row);
+    const unsigned char* ok = use.ptr<unsigned char>(row);
     auto* dst = out.ptr<unsigned char>(row);
     for (int col = 0; col < values.cols; ++col) {
-      if ((ok == nullptr || ok[col] != 0) && !std::isnan(in[col])) {
-        dst[col] = cv::saturate_cast<unsigned char>((in[col] - low) * gain);
-      }
+      if (ok[col] != 0) dst[col] = cv::saturate_cast<unsigned char>((in[col] - low) * gain);
     }
   }
   return out;

@@ -198,11 +198,11 @@ RasterWindow rasterWindow(const RasterInfo& info, const RasterRegion& region) {
   window.out_width = window.width / k;
   window.out_height = window.height / k;
   const std::int64_t samples = std::int64_t{window.out_width} * window.out_height;
-  if (samples > kMaxRasterSamples) {
+  if (samples > region.max_samples) {
     throw TerrainError(info.path + ": reading " + std::to_string(window.out_width) + " x " +
                        std::to_string(window.out_height) +
                        " samples is more than nadir reads at once (" +
-                       std::to_string(kMaxRasterSamples) +
+                       std::to_string(region.max_samples) +
                        "); read a smaller square (world.extent_m) or coarser (world.resolution_m)");
   }
   window.georef = info.georef;
@@ -245,9 +245,7 @@ std::vector<BandSamples> readBands(const RasterInfo& info, const std::vector<int
                          " (truncated or corrupt?)" + errors.said());
     }
     if (isSignedByte(*band)) {
-      samples.values.forEach<float>([](float& v, const int*) {
-        if (v > 127.0f) v -= 256.0f;
-      });
+      cv::subtract(samples.values, cv::Scalar(256.0), samples.values, samples.values > 127.0f);
     }
     samples.valid.create(window.out_height, window.out_width, CV_8U);
     if ((band->GetMaskFlags() & GMF_ALL_VALID) != 0) {
@@ -260,9 +258,11 @@ std::vector<BandSamples> readBands(const RasterInfo& info, const std::vector<int
                          std::to_string(index) + errors.said());
     }
     if (!as_bytes) {
-      samples.valid.forEach<unsigned char>([&samples](unsigned char& ok, const int* at) {
-        if (std::isnan(samples.values.at<float>(at[0], at[1]))) ok = 0;
-      });
+      // NaN is the one value unequal to itself. Whole-raster OpenCV operations here, not
+      // a loop per sample: a raster can hold 2^28 samples.
+      cv::Mat not_nan;
+      cv::compare(samples.values, samples.values, not_nan, cv::CMP_EQ);
+      samples.valid &= not_nan;
     }
     out.push_back(std::move(samples));
   }

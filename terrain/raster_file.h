@@ -32,6 +32,9 @@ struct RasterInfo {
 };
 
 // The part of a raster to read and how finely.
+// The most samples one read may give by default (1 GiB of float heights).
+inline constexpr std::int64_t kMaxRasterSamples = std::int64_t{1} << 28;
+
 struct RasterRegion {
   // The north-up ground square with sides 2 half_size_m around centre, on
   // the tangent plane at centre; 0: the whole raster.
@@ -43,6 +46,8 @@ struct RasterRegion {
   // left out), in the samples' type (an integer DEM's means are rounded), from
   // the file's overviews where it has them.
   double resolution_m = 0.0;
+  // The most samples a band read may give; a read that would give more is refused.
+  std::int64_t max_samples = kMaxRasterSamples;
 };
 
 // A rectangle of full-resolution pixels and the out_width x out_height
@@ -64,9 +69,6 @@ struct BandSamples {
   cv::Mat valid;
 };
 
-// The most samples one read may give (1 GiB of float heights).
-inline constexpr std::int64_t kMaxRasterSamples = std::int64_t{1} << 28;
-
 // Opens path with GDAL. A file that names no CRS (an ESRI grid without .prj)
 // is taken to be in crs_if_none. Throws TerrainError naming path for a file
 // GDAL cannot read, one without georeferencing, or a rotated or south-up one.
@@ -74,7 +76,7 @@ RasterInfo readRasterInfo(const std::string& path, const Crs& crs_if_none = Crs:
 
 // The window of info's raster under region, with a margin of two pixels,
 // clipped to the raster. Throws TerrainError naming the file if the square
-// misses the raster or the read would give more than kMaxRasterSamples.
+// misses the raster or the read would give more than region.max_samples.
 RasterWindow rasterWindow(const RasterInfo& info, const RasterRegion& region);
 
 // Bands (1-based) of window: 8-bit bands as CV_8U when eight_bit is true,

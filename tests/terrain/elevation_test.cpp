@@ -426,6 +426,22 @@ TEST(GdalTerrain, AWindowIsTheSameSamplesAsTheWholeFile) {
                      dataPath("zion_srtm.tif"), "outside the raster");
 }
 
+TEST(GdalTerrain, AReadOverItsSampleLimitIsRefusedNamingTheLimit) {
+  // A read may give at most region.max_samples samples: the whole file at
+  // exactly its width x height reads, one fewer is refused with the limit and
+  // the two settings that make a read smaller in the message.
+  const ElevationRaster whole = readElevation(dataPath("zion_srtm.tif"));
+  ElevationReadOptions options;
+  options.region.max_samples = std::int64_t{whole.width} * whole.height;
+  EXPECT_EQ(readElevation(dataPath("zion_srtm.tif"), options).height_m, whole.height_m);
+  options.region.max_samples -= 1;
+  const std::string limit = std::to_string(options.region.max_samples);
+  expectTerrainError([&] { readElevation(dataPath("zion_srtm.tif"), options); },
+                     dataPath("zion_srtm.tif"), "more than nadir reads at once (" + limit + ")");
+  expectTerrainError([&] { readElevation(dataPath("zion_srtm.tif"), options); },
+                     dataPath("zion_srtm.tif"), "world.resolution_m");
+}
+
 TEST(GdalTerrain, Nad83UtmDem) {
   // A 3 x 2 DEM in NAD83 / UTM 12N (EPSG:26912, as USGS 3DEP tiles come),
   // 10 m pixels, heights 100 + col + 10 row: read with its CRS; the height

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -243,6 +244,24 @@ TEST(Stretch, BadPercentilesAreAnError) {
                {0, 0, 0, 5, 50, 0}, geographicKeys());
   EXPECT_THROW(readImageryRgb(path, {}, {.low_percent = 50, .high_percent = 50}), TerrainError);
   EXPECT_THROW(readImageryRgb(path, {}, {.low_percent = -1, .high_percent = 50}), TerrainError);
+}
+
+TEST(Stretch, PercentilesOfTheValidSamplesMapTo0And255) {
+  // Ten valid samples 0..9 between a NaN and a masked 1000: the 10th and 90th
+  // percentiles are the samples of rank round(0.1 x 9) = 1 and round(0.9 x 9) = 8,
+  // so v becomes (v - 1) x 255 / 7 rounded and clamped to 0..255; the NaN and
+  // the masked sample become 0 and take no part in the percentiles.
+  cv::Mat band(1, 12, CV_32F);
+  cv::Mat valid(1, 12, CV_8U, cv::Scalar(255));
+  for (int col = 0; col < 10; ++col) band.at<float>(0, col) = static_cast<float>(col);
+  band.at<float>(0, 10) = std::numeric_limits<float>::quiet_NaN();
+  band.at<float>(0, 11) = 1000.0f;
+  valid.at<unsigned char>(0, 11) = 0;
+  const cv::Mat out =
+      stretchBand(band, valid, {.low_percent = 10.0, .high_percent = 90.0}, "test band");
+  const std::vector<int> expected{0, 0, 36, 73, 109, 146, 182, 219, 255, 255, 0, 0};
+  ASSERT_EQ(out.type(), CV_8U);
+  for (int col = 0; col < 12; ++col) EXPECT_EQ(out.at<unsigned char>(0, col), expected[col]) << col;
 }
 
 }  // namespace
