@@ -11,6 +11,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <string_view>
@@ -102,6 +104,33 @@ OGRSpatialReference wgs84Geographic() {
   return wgs84;
 }
 
+// PROJ's transformations for srs, shared by every Crs of the same WKT: a world
+// reads its DEM, imagery and geoid, often in one CRS, and PROJ takes tens of
+// milliseconds to build a transformation. Held weakly: one lives only while a
+// Crs uses it.
+std::shared_ptr<const CrsTransform> sharedTransform(OGRSpatialReference srs,
+                                                    const std::string& source) {
+  char* text = nullptr;
+  srs.exportToWkt(&text);
+  const std::string wkt = text == nullptr ? "" : text;
+  CPLFree(text);
+  if (wkt.empty()) return std::make_shared<const CrsTransform>(std::move(srs), source);
+  static std::mutex mutex;
+  static std::map<std::string, std::weak_ptr<const CrsTransform>> built;
+  {
+    const std::lock_guard lock(mutex);
+    const auto found = built.find(wkt);
+    if (found != built.end()) {
+      if (auto transform = found->second.lock()) return transform;
+    }
+  }
+  auto transform = std::make_shared<const CrsTransform>(std::move(srs), source);
+  const std::lock_guard lock(mutex);
+  std::erase_if(built, [](const auto& entry) { return entry.second.expired(); });
+  built[wkt] = transform;
+  return transform;
+}
+
 // The fast path for WGS-84 geographic and UTM (in metres), else PROJ's.
 Crs crsOf(OGRSpatialReference srs, const std::string& source) {
   if (srs.IsCompound()) srs.StripVertical();
@@ -125,7 +154,7 @@ Crs crsOf(OGRSpatialReference srs, const std::string& source) {
   }
   Crs crs;
   crs.kind = Crs::Kind::kOther;
-  crs.other = std::make_shared<const CrsTransform>(std::move(srs), source);
+  crs.other = sharedTransform(std::move(srs), source);
   return crs;
 }
 

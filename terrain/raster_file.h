@@ -31,10 +31,10 @@ struct RasterInfo {
   int overviews = 0;  // band 1's reduced-resolution copies
 };
 
-// The part of a raster to read and how finely.
 // The most samples one read may give by default (1 GiB of float heights).
 inline constexpr std::int64_t kMaxRasterSamples = std::int64_t{1} << 28;
 
+// The part of a raster to read and how finely.
 struct RasterRegion {
   // The north-up ground square with sides 2 half_size_m around centre, on
   // the tangent plane at centre; 0: the whole raster.

@@ -120,6 +120,19 @@ TEST(Crs, Nad83UtmIsWithinTheDatumShiftOfWgs84Utm) {
   EXPECT_NEAR(size.row_m, 30.0, 30.0 * 4e-4);
 }
 
+TEST(Crs, OneCrsBuildsItsTransformationsOnce) {
+  // Every Crs of one CRS shares one PROJ transformation while any of them
+  // lives; another CRS has its own.
+  const Crs first = Crs::fromEpsg(26912, "first");
+  const Crs second = Crs::fromDefinition("EPSG:26912", "second");
+  const Crs mercator = Crs::fromEpsg(3857, "third");
+  ASSERT_NE(first.other, nullptr);
+  EXPECT_EQ(first.other.get(), second.other.get());
+  EXPECT_NE(first.other.get(), mercator.other.get());
+  const core::Geodetic zion = core::geodeticFromDegrees(37.3, -113.0, 0.0);
+  EXPECT_EQ(first.fromGeodetic(zion).x, second.fromGeodetic(zion).x);
+}
+
 TEST(RasterGeoref, IntegerPixelCoordinatesAreCentres) {
   // Corner (10, 50), 0.5 x 0.25 deg pixels: pixel (0,0) is centred half a
   // pixel in from the corner, and the corner is pixel (-0.5, -0.5).
