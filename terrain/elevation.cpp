@@ -50,16 +50,15 @@ void explainHgt(const std::string& path) {
 // Band 1 of region of a raster, voids NaN.
 ElevationRaster readSingleBand(const RasterInfo& info, const RasterRegion& region) {
   const RasterWindow window = rasterWindow(info, region);
-  const BandSamples samples = readBands(info, {1}, window, false).front();
+  BandSamples samples = std::move(readBands(info, {1}, window, false).front());
   ElevationRaster raster;
   raster.width = window.out_width;
   raster.height = window.out_height;
   raster.georef = window.georef;
   raster.source = info.path;
-  cv::Mat heights = samples.values.clone();
-  heights.setTo(kVoid, samples.valid == 0);
-  const auto* first = heights.ptr<float>();
-  raster.height_m.assign(first, first + heights.total());
+  samples.values.setTo(kVoid, samples.valid == 0);
+  const auto* first = samples.values.ptr<float>();
+  raster.height_m.assign(first, first + samples.values.total());
   return raster;
 }
 

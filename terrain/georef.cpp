@@ -21,11 +21,24 @@
 
 namespace nadir::terrain {
 
-// PROJ's two transformations between WGS-84 and one CRS. OGR's
-// transformations keep state, so each call holds a lock.
+namespace {
+
+std::string wktOf(const OGRSpatialReference& srs) {
+  char* text = nullptr;
+  srs.exportToWkt(&text);
+  std::string wkt = text == nullptr ? "" : text;
+  CPLFree(text);
+  return wkt;
+}
+
+}  // namespace
+
+// PROJ's two transformations between WGS-84 and one CRS (srs, whose WKT is
+// wkt). OGR's transformations keep state, so each call holds a lock.
 class CrsTransform {
  public:
-  CrsTransform(OGRSpatialReference srs, const std::string& source) : srs_(std::move(srs)) {
+  CrsTransform(OGRSpatialReference srs, std::string wkt, const std::string& source)
+      : srs_(std::move(srs)), wkt_(std::move(wkt)) {
     srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     OGRSpatialReference wgs84;
     wgs84.SetWellKnownGeogCS("WGS84");
@@ -42,10 +55,6 @@ class CrsTransform {
       throw TerrainError(source + ": PROJ has no transformation between WGS 84 and " + name() +
                          errors.said());
     }
-    char* wkt = nullptr;
-    srs_.exportToWkt(&wkt);
-    wkt_ = wkt == nullptr ? "" : wkt;
-    CPLFree(wkt);
   }
 
   CrsPoint fromGeodetic(double lat_deg, double lon_deg) const {
@@ -110,11 +119,8 @@ OGRSpatialReference wgs84Geographic() {
 // Crs uses it.
 std::shared_ptr<const CrsTransform> sharedTransform(OGRSpatialReference srs,
                                                     const std::string& source) {
-  char* text = nullptr;
-  srs.exportToWkt(&text);
-  const std::string wkt = text == nullptr ? "" : text;
-  CPLFree(text);
-  if (wkt.empty()) return std::make_shared<const CrsTransform>(std::move(srs), source);
+  std::string wkt = wktOf(srs);
+  if (wkt.empty()) return std::make_shared<const CrsTransform>(std::move(srs), wkt, source);
   static std::mutex mutex;
   static std::map<std::string, std::weak_ptr<const CrsTransform>> built;
   {
@@ -124,7 +130,7 @@ std::shared_ptr<const CrsTransform> sharedTransform(OGRSpatialReference srs,
       if (auto transform = found->second.lock()) return transform;
     }
   }
-  auto transform = std::make_shared<const CrsTransform>(std::move(srs), source);
+  auto transform = std::make_shared<const CrsTransform>(std::move(srs), wkt, source);
   const std::lock_guard lock(mutex);
   std::erase_if(built, [](const auto& entry) { return entry.second.expired(); });
   built[wkt] = transform;
@@ -226,11 +232,7 @@ std::string Crs::wkt() const {
   if (kind == Kind::kOther) return other->wkt();
   OGRSpatialReference srs = wgs84Geographic();
   if (kind == Kind::kUtm) srs.SetUTM(utm_zone, utm_north ? 1 : 0);
-  char* text = nullptr;
-  srs.exportToWkt(&text);
-  std::string wkt = text == nullptr ? "" : text;
-  CPLFree(text);
-  return wkt;
+  return wktOf(srs);
 }
 
 bool Crs::operator==(const Crs& rhs) const {
