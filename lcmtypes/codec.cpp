@@ -219,7 +219,9 @@ std::optional<JpegFrameSize> jpegFrameSize(const std::vector<std::uint8_t>& jpeg
 // declare more would have a node decode gigapixels of nothing.
 constexpr std::int64_t kMaxJpegPixelsPerByte = 512;
 
-Image imageFromLcm(const nadir::image_t& message) {
+// An image_t's fields as an Image; its pixel bytes are data (size bytes),
+// which are message.data unless they were decoded apart (decode<Image>).
+Image imageFromLcm(const nadir::image_t& message, const std::uint8_t* data, std::size_t size) {
   const auto fail = [&](const std::string& what) {
     return InvalidMessage("image_t " + std::to_string(message.width) + "x" +
                           std::to_string(message.height) + " at utime " +
@@ -230,23 +232,20 @@ Image imageFromLcm(const nadir::image_t& message) {
   for (const nadir::image_metadata_t& entry : message.metadata) {
     image.metadata.emplace_back(entry.key, entry.value);
   }
-  if (message.size != static_cast<std::int32_t>(message.data.size())) {
-    throw fail("size field " + std::to_string(message.size) + " but " +
-               std::to_string(message.data.size()) + " bytes of data");
-  }
   if (message.width <= 0 || message.height <= 0) throw fail("no pixels");
   if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_MJPEG) {
-    const std::optional<JpegFrameSize> frame = jpegFrameSize(message.data);
+    const std::vector<std::uint8_t>& jpeg = message.data;
+    const std::optional<JpegFrameSize> frame = jpegFrameSize(jpeg);
     if (!frame) throw fail("JPEG data has no frame header");
     if (frame->width != message.width || frame->height != message.height) {
       throw fail("JPEG is " + std::to_string(frame->width) + "x" + std::to_string(frame->height));
     }
     if (std::int64_t{message.width} * message.height >
-        kMaxJpegPixelsPerByte * static_cast<std::int64_t>(message.data.size())) {
-      throw fail("a JPEG of " + std::to_string(message.data.size()) + " bytes cannot hold " +
+        kMaxJpegPixelsPerByte * static_cast<std::int64_t>(jpeg.size())) {
+      throw fail("a JPEG of " + std::to_string(jpeg.size()) + " bytes cannot hold " +
                  std::to_string(std::int64_t{message.width} * message.height) + " pixels");
     }
-    cv::Mat decoded = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
+    cv::Mat decoded = cv::imdecode(jpeg, cv::IMREAD_UNCHANGED);
     if (decoded.empty()) throw fail("JPEG data does not decode");
     if (decoded.cols != message.width || decoded.rows != message.height) {
       throw fail("JPEG is " + std::to_string(decoded.cols) + "x" + std::to_string(decoded.rows));
@@ -268,17 +267,28 @@ Image imageFromLcm(const nadir::image_t& message) {
       throw fail("unsupported pixel format " + std::to_string(message.pixelformat));
   }
   if (message.row_stride < message.width * channels ||
-      static_cast<std::int64_t>(message.row_stride) * message.height > message.size) {
+      static_cast<std::int64_t>(message.row_stride) * message.height >
+          static_cast<std::int64_t>(size)) {
     throw fail("row stride " + std::to_string(message.row_stride) + " does not fit " +
-               std::to_string(message.size) + " bytes");
+               std::to_string(size) + " bytes");
   }
   const cv::Mat view(message.height, message.width, channels == 1 ? CV_8UC1 : CV_8UC3,
-                     const_cast<std::uint8_t*>(message.data.data()),
-                     static_cast<std::size_t>(message.row_stride));
+                     const_cast<std::uint8_t*>(data), static_cast<std::size_t>(message.row_stride));
   image.pixels = view.clone();
   if (message.pixelformat == nadir::image_t::PIXEL_FORMAT_BGR)
     cv::cvtColor(image.pixels, image.pixels, cv::COLOR_BGR2RGB);
   return image;
+}
+
+Image imageFromLcm(const nadir::image_t& message) {
+  if (message.size != static_cast<std::int32_t>(message.data.size())) {
+    throw InvalidMessage("image_t " + std::to_string(message.width) + "x" +
+                         std::to_string(message.height) + " at utime " +
+                         std::to_string(message.utime) + ": size field " +
+                         std::to_string(message.size) + " but " +
+                         std::to_string(message.data.size()) + " bytes of data");
+  }
+  return imageFromLcm(message, message.data.data(), message.data.size());
 }
 
 // ---------------------------------------------------------------- the type table
@@ -537,6 +547,14 @@ Bytes encode(const Image& message) {
   out.utime = message.utime;
   out.width = pixels.cols;
   out.height = pixels.rows;
+  for (const auto& [key, value] : message.metadata) {
+    nadir::image_metadata_t entry;
+    entry.key = key;
+    entry.value = value;
+    entry.n = static_cast<std::int32_t>(value.size());
+    out.metadata.push_back(std::move(entry));
+  }
+  out.nmetadata = static_cast<std::int32_t>(out.metadata.size());
   if (message.jpeg_quality > 0) {
     cv::Mat bgr;
     if (!gray) cv::cvtColor(pixels, bgr, cv::COLOR_RGB2BGR);
@@ -546,23 +564,31 @@ Bytes encode(const Image& message) {
     out.row_stride = 0;
     out.pixelformat = nadir::image_t::PIXEL_FORMAT_MJPEG;
     out.data = std::move(jpeg);
-  } else {
-    out.row_stride = pixels.cols * pixels.channels();
-    out.pixelformat = gray ? std::int32_t{nadir::image_t::PIXEL_FORMAT_GRAY}
-                           : std::int32_t{nadir::image_t::PIXEL_FORMAT_RGB};
-    const cv::Mat continuous = pixels.isContinuous() ? pixels : pixels.clone();
-    out.data.assign(continuous.data, continuous.data + continuous.total() * continuous.elemSize());
+    out.size = static_cast<std::int32_t>(out.data.size());
+    return toBytes(out);
   }
-  out.size = static_cast<std::int32_t>(out.data.size());
-  for (const auto& [key, value] : message.metadata) {
-    nadir::image_metadata_t entry;
-    entry.key = key;
-    entry.value = value;
-    entry.n = static_cast<std::int32_t>(value.size());
-    out.metadata.push_back(std::move(entry));
-  }
-  out.nmetadata = static_cast<std::int32_t>(out.metadata.size());
-  return toBytes(out);
+  // Raw pixels go from the image straight into the bytes, copied once: the
+  // message is encoded without them, and they are put in where data goes,
+  // right after the fingerprint, utime and five int32 fields.
+  out.row_stride = pixels.cols * pixels.channels();
+  out.pixelformat = gray ? std::int32_t{nadir::image_t::PIXEL_FORMAT_GRAY}
+                         : std::int32_t{nadir::image_t::PIXEL_FORMAT_RGB};
+  out.size = 0;
+  const Bytes without_pixels = toBytes(out);
+  constexpr std::size_t kDataOffset = 8 + 8 + 5 * 4;
+  const std::size_t row_bytes = static_cast<std::size_t>(out.row_stride);
+  const std::size_t data_bytes = row_bytes * static_cast<std::size_t>(pixels.rows);
+  Bytes bytes;
+  bytes.reserve(without_pixels.size() + data_bytes);
+  bytes.insert(bytes.end(), without_pixels.begin(), without_pixels.begin() + kDataOffset);
+  for (int shift = 24, i = 0; i < 4; shift -= 8, ++i)  // size, big-endian
+    bytes[kDataOffset - 4 + static_cast<std::size_t>(i)] =
+        static_cast<std::uint8_t>(static_cast<std::uint32_t>(data_bytes) >> shift);
+  for (int row = 0; row < pixels.rows; ++row)
+    bytes.insert(bytes.end(), pixels.ptr<std::uint8_t>(row),
+                 pixels.ptr<std::uint8_t>(row) + row_bytes);
+  bytes.insert(bytes.end(), without_pixels.begin() + kDataOffset, without_pixels.end());
+  return bytes;
 }
 
 Bytes encode(const VoEstimate& message) {
@@ -825,6 +851,29 @@ CameraInfo decode<CameraInfo>(const void* data, std::size_t size) {
 
 template <>
 Image decode<Image>(const void* data, std::size_t size) {
+  // Raw pixels are copied once, from the bytes into the image: the generated
+  // decoder reads every other field from a copy of the bytes without them
+  // (the size field 0), and the pixels come straight from where data lies.
+  // Bytes that do not decode that way go the whole way, for its errors.
+  constexpr std::size_t kSizeOffset = 8 + 8 + 4 * 4, kDataOffset = kSizeOffset + 4;
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  if (size >= kDataOffset && fingerprintOf(data, size) == nadir::image_t::getHash() &&
+      !isJpegImage(data, size)) {
+    std::uint32_t size_field = 0;
+    for (std::size_t i = 0; i < 4; ++i) size_field = (size_field << 8) | bytes[kSizeOffset + i];
+    const std::size_t pixel_bytes = size_field;
+    if (size_field <= 0x7FFFFFFFu && pixel_bytes <= size - kDataOffset) {
+      std::vector<std::uint8_t> without_pixels(bytes, bytes + kDataOffset);
+      std::fill(without_pixels.begin() + kSizeOffset, without_pixels.end(), 0);
+      without_pixels.insert(without_pixels.end(), bytes + kDataOffset + pixel_bytes, bytes + size);
+      std::optional<nadir::image_t> message;
+      try {
+        message = fromBytes<nadir::image_t>(without_pixels.data(), without_pixels.size());
+      } catch (const DecodeError&) {
+      }
+      if (message) return imageFromLcm(*message, bytes + kDataOffset, pixel_bytes);
+    }
+  }
   return imageFromLcm(fromBytes<nadir::image_t>(data, size));
 }
 

@@ -238,6 +238,45 @@ TEST(Codec, RawImagesRoundTrip) {
   }
 }
 
+// A raw image's bytes are the generated encoder's for the same fields, with or
+// without metadata, from a whole image or a region of one (rows apart in memory).
+TEST(Codec, RawImageBytesAreTheGeneratedEncodersBytes) {
+  for (int channels : {1, 3}) {
+    const cv::Mat whole = gradient(channels);
+    const cv::Mat region = whole(cv::Rect(5, 3, 40, 30));
+    for (const cv::Mat& pixels : {whole, region}) {
+      for (const bool with_metadata : {false, true}) {
+        Image image{-42, pixels, 0, {}};
+        if (with_metadata) image.metadata = {{"exposure_s", {'1'}}, {"gain", {'2', '.', '5'}}};
+        nadir::image_t expected{};
+        expected.utime = -42;
+        expected.width = pixels.cols;
+        expected.height = pixels.rows;
+        expected.row_stride = pixels.cols * channels;
+        expected.pixelformat = channels == 1 ? std::int32_t{nadir::image_t::PIXEL_FORMAT_GRAY}
+                                             : std::int32_t{nadir::image_t::PIXEL_FORMAT_RGB};
+        for (int row = 0; row < pixels.rows; ++row)
+          expected.data.insert(expected.data.end(), pixels.ptr<std::uint8_t>(row),
+                               pixels.ptr<std::uint8_t>(row) + expected.row_stride);
+        expected.size = static_cast<std::int32_t>(expected.data.size());
+        for (const auto& [key, value] : image.metadata) {
+          nadir::image_metadata_t entry;
+          entry.key = key;
+          entry.value = value;
+          entry.n = static_cast<std::int32_t>(value.size());
+          expected.metadata.push_back(entry);
+        }
+        expected.nmetadata = static_cast<std::int32_t>(expected.metadata.size());
+        Bytes expected_bytes(static_cast<std::size_t>(expected.getEncodedSize()));
+        ASSERT_GT(
+            expected.encode(expected_bytes.data(), 0, static_cast<int>(expected_bytes.size())), 0);
+        EXPECT_EQ(encode(image), expected_bytes)
+            << channels << " channels, " << pixels.cols << " columns, metadata " << with_metadata;
+      }
+    }
+  }
+}
+
 // JPEG images decode to the same size and close to the original pixels.
 TEST(Codec, JpegImagesDecode) {
   const Image image{0, gradient(3), 95, {}};
@@ -305,6 +344,28 @@ TEST(Codec, AJpegIsCheckedBeforeItIsDecoded) {
   EXPECT_NE(invalidReason<Image>(huge).find(" bytes cannot hold 179335800 pixels"),
             std::string::npos)
       << invalidReason<Image>(huge);
+}
+
+// A raw image with metadata cut anywhere (in a field, the pixels, a key or a
+// value) or with a byte too many is a DecodeError, as the generated decoder
+// refuses it; a pixel count one short or one over shifts the metadata and is
+// refused too.
+TEST(Codec, CutOrPaddedRawImagesAreDecodeErrors) {
+  const Bytes whole = encode(Image{7, gradient(1), 0, {{"exposure_s", {'0', '.', '5'}}}});
+  ASSERT_EQ(decode<Image>(whole).metadataText("exposure_s"), "0.5");
+  for (std::size_t length = 0; length < whole.size(); ++length) {
+    EXPECT_THROW(decode<Image>(whole.data(), length), DecodeError) << "length " << length;
+  }
+  Bytes padded = whole;
+  padded.push_back(0);
+  EXPECT_THROW(decode<Image>(padded), DecodeError);
+  for (const int delta : {-1, 1}) {
+    Bytes shifted = whole;
+    const std::uint32_t size = 64 * 48 + static_cast<std::uint32_t>(delta);
+    for (int i = 0; i < 4; ++i)
+      shifted[32 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(size >> (24 - 8 * i));
+    EXPECT_ANY_THROW(decode<Image>(shifted)) << "size off by " << delta;
+  }
 }
 
 // A count or string length in the bytes that the bytes cannot hold is a
