@@ -1,9 +1,11 @@
 // nadir-bench-render: flies a straight line over the procedural world at a
 // fixed height above ground and renders every camera frame, timing each
 // frame from the pose to an encoded image_t (render, readback, encoding).
-// Prints frames/s, ms/frame (median, p95) per camera and the peak RSS.
+// Prints frames/s, ms/frame (median, p95) per camera and the peak RSS, then
+// the same camera re-rendering the flight's first pose (no new ground) and
+// the flight's speed as a share of that.
 //
-//   nadir-bench-render [--seconds 60] [--speed 25] [--agl 300] [--seed 1]
+//   nadir-bench-render [--seconds 60] [--speed 25] [--agl 300] [--seed 1] [--timing]
 
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -14,6 +16,7 @@
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,7 @@
 #include "core/clock.h"
 #include "core/command_line.h"
 #include "core/frames.h"
+#include "core/stage_times.h"
 #include "lcmtypes/codec.h"
 #include "render/camera_renderer.h"
 #include "render/egl_context.h"
@@ -72,9 +76,13 @@ int main(int argc, char** argv) {
   nadir::render::TerrainRendererParams renderer_params;
   app.add_flag("--objects", renderer_params.objects_3d,
                "trees and buildings as 3D objects (renderer.objects_3d)");
+  app.add_flag("--no-prefetch{false}", renderer_params.prefetch_tiles,
+               "make each tile's imagery when it is first drawn (renderer.prefetch_tiles=false)");
   std::string frame_png;
   app.add_option("--frame-png", frame_png,
                  "write each camera's first frame here (the camera's name is appended)");
+  bool timing = false;
+  app.add_flag("--timing", timing, "print where each camera's flight spent its time, by stage");
   if (const auto status = nadir::core::parseCommandLine(app, argc, argv)) return *status;
 
   nadir::render::HeadlessGlContext context;
@@ -89,7 +97,9 @@ int main(int argc, char** argv) {
       seconds, speed_mps, agl_m, static_cast<long long>(seed), world_params.size_m / 1000.0);
   std::printf("tiles: %d px textures, %d mesh quads, refine above %.2f px per texel\n",
               tile_params.texture_px, tile_params.mesh_quads, tile_params.max_texel_px);
-  std::printf("3D trees and buildings: %s\n", renderer_params.objects_3d ? "on" : "off");
+  std::printf("3D trees and buildings: %s; tile imagery made ahead: %s\n",
+              renderer_params.objects_3d ? "on" : "off",
+              renderer_params.prefetch_tiles ? "yes" : "no");
   std::printf("%-26s %8s %9s %9s %9s %8s %9s %8s %8s %9s\n", "camera", "frames", "frames/s",
               "median ms", "p95 ms", "tiles", "triangles", "objects", "made", "RSS MiB");
 
@@ -119,13 +129,8 @@ int main(int argc, char** argv) {
                            Eigen::Vector3d(45.0 * M_PI / 180.0, 0.0, 0.0);
     motion.v_cam_mps = Eigen::Vector3d(0.0, -speed_mps, 0.0);
     const int frames = static_cast<int>(seconds * c.fps);
-    std::vector<double> frame_ms;
-    frame_ms.reserve(static_cast<std::size_t>(frames));
-    long tiles_drawn = 0, triangles = 0, uploads = 0, objects = 0;
-    const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < frames; ++i) {
-      const double t_s = i / c.fps;
-      // Heading 30 deg east of north from the origin.
+    // Heading 30 deg east of north from the origin.
+    const auto poseAt = [&](double t_s) {
       const double north = std::cos(0.5236) * speed_mps * t_s,
                    east = std::sin(0.5236) * speed_mps * t_s;
       Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
@@ -133,14 +138,40 @@ int main(int argc, char** argv) {
                              nadir::core::rotationBodyFromDownCamera();
       T_world_cam.translation() =
           Eigen::Vector3d(north, east, -(world->groundUp_m(north, east) + agl_m));
+      return T_world_cam;
+    };
+    // One frame from the pose to an encoded image_t, ms.
+    const auto frameMs = [&](const Eigen::Isometry3d& T_world_cam, double t_s,
+                             nadir::render::RenderedImage& image) {
       const auto frame_start = std::chrono::steady_clock::now();
-      const nadir::render::RenderedImage image =
-          camera.render(T_world_cam, nadir::core::utimeFromSeconds(t_s), false, motion);
+      image = camera.render(T_world_cam, nadir::core::utimeFromSeconds(t_s), false, motion);
+      const nadir::core::ScopedStage stage("encode image_t");
       const std::vector<std::uint8_t> bytes =
           nadir::msg::encode(nadir::msg::Image{image.utime, image.image, 0, {}});
-      frame_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frame_start)
-              .count());
+      if (bytes.empty()) throw std::runtime_error("an image encoded to no bytes");
+      return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                       frame_start)
+          .count();
+    };
+    struct Row {
+      double frames_per_s = 0.0, median_ms = 0.0, p95_ms = 0.0;
+    };
+    const auto rowOf = [](std::vector<double> frame_ms, double total_s) {
+      std::sort(frame_ms.begin(), frame_ms.end());
+      return Row{static_cast<double>(frame_ms.size()) / total_s, frame_ms[frame_ms.size() / 2],
+                 frame_ms[frame_ms.size() * 95 / 100]};
+    };
+
+    nadir::core::enableStageTimes(timing);
+    nadir::core::clearStageTimes();
+    std::vector<double> frame_ms;
+    frame_ms.reserve(static_cast<std::size_t>(frames));
+    long tiles_drawn = 0, triangles = 0, uploads = 0, objects = 0;
+    nadir::render::RenderedImage image;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < frames; ++i) {
+      const double t_s = i / c.fps;
+      frame_ms.push_back(frameMs(poseAt(t_s), t_s, image));
       if (i == 0 && !frame_png.empty()) {
         std::string name = c.name;
         std::replace(name.begin(), name.end(), ' ', '_');
@@ -152,16 +183,42 @@ int main(int argc, char** argv) {
       objects += image.stats.objects;
       triangles += image.stats.triangles;
       uploads += image.stats.tiles_uploaded;
-      if (bytes.empty()) return 1;
     }
     const double total_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::vector<double> sorted = frame_ms;
-    std::sort(sorted.begin(), sorted.end());
+    nadir::core::enableStageTimes(false);
+    const Row flight = rowOf(frame_ms, total_s);
     std::printf("%-26s %8d %9.1f %9.2f %9.2f %8.1f %9.0f %8.0f %8ld %9.0f\n", c.name, frames,
-                frames / total_s, sorted[sorted.size() / 2], sorted[sorted.size() * 95 / 100],
+                flight.frames_per_s, flight.median_ms, flight.p95_ms,
                 static_cast<double>(tiles_drawn) / frames, static_cast<double>(triangles) / frames,
                 static_cast<double>(objects) / frames, uploads, peakRssKib() / 1024.0);
+
+    if (const nadir::terrain::TilePrefetcher* prefetcher = terrain.prefetcher()) {
+      const nadir::terrain::TilePrefetchStats made = prefetcher->stats();
+      std::printf("  new tiles' imagery: %lld made ahead and taken, %lld made when drawn\n",
+                  static_cast<long long>(made.taken_ready), static_cast<long long>(made.made_here));
+    }
+
+    // The reference: the flight's first pose again and again (its tiles made
+    // once, before timing), as many frames as 20 s of the camera at most.
+    const int reference_frames = std::min(frames, static_cast<int>(20.0 * c.fps));
+    const Eigen::Isometry3d T_first = poseAt(0.0);
+    frameMs(T_first, 0.0, image);
+    std::vector<double> reference_ms;
+    const auto reference_start = std::chrono::steady_clock::now();
+    for (int i = 0; i < reference_frames; ++i)
+      reference_ms.push_back(frameMs(T_first, i / c.fps, image));
+    const Row reference = rowOf(
+        reference_ms,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - reference_start).count());
+    std::printf("%-26s %8d %9.1f %9.2f %9.2f   flight / one pose: %.2f\n", "  one pose again",
+                reference_frames, reference.frames_per_s, reference.median_ms, reference.p95_ms,
+                flight.frames_per_s / reference.frames_per_s);
+    if (timing) {
+      std::printf(
+          "\n%s\n",
+          nadir::core::formatStageTimes(nadir::core::stageTimes(), total_s, frames).c_str());
+    }
   }
   return 0;
 }

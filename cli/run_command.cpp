@@ -32,6 +32,7 @@ void endRunProgress() {
 
 void finishRun(const run::RunResult& result) {
   std::cout << "\n" << result.table << "\n";
+  if (!result.stage_times.empty()) std::cout << result.stage_times << "\n";
   std::cout << "wrote " << result.log_path << " (replay: lcm-logplayer " << result.log_path
             << ")\n      " << result.metrics_path << "\n";
   for (const std::string& path : result.tum_paths) std::cout << "      " << path << "\n";
@@ -55,6 +56,12 @@ void addRunCommand(CLI::App& app) {
   command->add_flag("--force", options->force, "replace an earlier run in the output folder");
   command->add_flag("--no-images{false}", options->record_images,
                     "leave the camera images out of run.lcmlog (metrics are unchanged)");
+  command->add_flag("--serial{false}", options->node_threads,
+                    "run the VO nodes in the bus's dispatch, not on their own threads (their "
+                    "estimates reach the others at once instead of with the next frame)");
+  command->add_flag("--timing", options->stage_times,
+                    "time the pipeline's stages and print where the wall time went (also "
+                    "DIR/stage_times.txt)");
   addFrameOption(command, options->tum_axes, "the TUM files written");
   command->callback([options] {
     const run::RunResult result = run::runScenario(*options, printRunProgress);

@@ -7,13 +7,31 @@
 #include <string_view>
 
 #include "core/bus.h"
+#include "core/stage_times.h"
 #include "lcmtypes/codec.h"
 
 namespace nadir::msg {
 
+// The stage names of a type's encoding and decoding (core/stage_times.h).
+template <class T>
+std::string_view encodeStageName() {
+  static const std::string name = std::string("encode ") + typeNameOf<T>();
+  return name;
+}
+template <class T>
+std::string_view decodeStageName() {
+  static const std::string name = std::string("decode ") + typeNameOf<T>();
+  return name;
+}
+
 template <class T>
 void publish(core::Bus& bus, std::string_view channel, const T& message) {
-  const Bytes bytes = encode(message);
+  Bytes bytes;
+  {
+    const core::ScopedStage stage(encodeStageName<T>());
+    bytes = encode(message);
+  }
+  const core::ScopedStage stage("send");
   bus.publish(channel, bytes.data(), bytes.size(), message.utime);
 }
 
@@ -33,6 +51,7 @@ core::Subscription subscribe(core::Bus& bus, const std::string& channel_regex,
                         on_invalid = std::move(on_invalid)](const core::RawMessage& raw) {
                          T message;
                          try {
+                           const core::ScopedStage stage(decodeStageName<T>());
                            message = decode<T>(raw.data, raw.size);
                          } catch (const DecodeError&) {
                            bus.countDecodeError(raw.channel);

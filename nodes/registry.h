@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -96,6 +97,13 @@ class Entry {
 
   // Builds the node on the bus; throws naming what is wrong in the params.
   virtual std::unique_ptr<Node> start(core::Bus& bus, const core::AnyParams& params) const = 0;
+  // The channels each of whose messages waits until the node has finished
+  // with everything before it (its camera's frames). In `nadir run` a node
+  // with any works on its own thread beside the camera (core/worker_bus.h).
+  virtual std::set<std::string> pacedChannels(const core::AnyParams& params) const {
+    (void)params;
+    return {};
+  }
   virtual std::vector<Stream> streams(const core::AnyParams& params) const = 0;
   // A section for a batch run's results table; empty for none.
   virtual std::string batchReport(const BatchReportInput& input,
@@ -123,6 +131,9 @@ class TypedEntry : public Entry {
   std::unique_ptr<Node> start(core::Bus& bus, const core::AnyParams& params) const override {
     return build(bus, params.as<P>());
   }
+  std::set<std::string> pacedChannels(const core::AnyParams& params) const override {
+    return paced(params.as<P>());
+  }
   std::vector<Stream> streams(const core::AnyParams& params) const override {
     return publishes(params.as<P>());
   }
@@ -136,6 +147,10 @@ class TypedEntry : public Entry {
   virtual P paramsFrom(const ScenarioParams& scenario) const = 0;
   virtual std::unique_ptr<Node> build(core::Bus& bus, const P& params) const = 0;
   virtual std::vector<Stream> publishes(const P& params) const = 0;
+  virtual std::set<std::string> paced(const P& params) const {
+    (void)params;
+    return {};
+  }
   virtual std::string report(const BatchReportInput& input, const P& params) const {
     (void)input;
     (void)params;

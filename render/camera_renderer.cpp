@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/stage_times.h"
 #include "render/egl_context.h"
 #include "render/gl.h"
 
@@ -377,6 +378,24 @@ double CameraRenderer::exposureGain(std::int64_t utime) {
   return ae_gain_;
 }
 
+void CameraRenderer::expectNextViews(const DrawView& view, std::int64_t utime) {
+  const Eigen::Vector3d p_m = view.T_world_cam.translation();
+  const double dt_s = static_cast<double>(utime - last_utime_) * 1e-6;
+  // The camera flies on at its last velocity and attitude; a guess only
+  // decides which tiles are made ahead, never what is drawn.
+  if (last_utime_ >= 0 && dt_s > 0.0 && dt_s < 1.0) {
+    const Eigen::Vector3d v_mps = (p_m - last_p_world_cam_m_) / dt_s;
+    std::vector<DrawView> next;
+    for (const double ahead_s : {0.5, 1.0, 2.0}) {
+      next.push_back(view);
+      next.back().T_world_cam.translation() = p_m + ahead_s * v_mps;
+    }
+    terrain_.expect(next);
+  }
+  last_p_world_cam_m_ = p_m;
+  last_utime_ = utime;
+}
+
 RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::int64_t utime,
                                      bool with_depth, const CameraMotion& motion) {
   const bool gray = params_.pixel_format == "gray8";
@@ -394,7 +413,16 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
   view.gray = gray;
   glBindFramebuffer(GL_FRAMEBUFFER, scene_->framebuffer);
   glViewport(0, 0, scene_->width, scene_->height);
-  out.stats = terrain_.draw(view);
+  {
+    const core::ScopedStage stage("draw");
+    out.stats = terrain_.draw(view);
+  }
+  expectNextViews(view, utime);
+  if (core::stageTimesEnabled()) {
+    // llvmpipe rasterises when the pixels are needed: timed, that is a stage of its own.
+    const core::ScopedStage stage("rasterise");
+    glFinish();
+  }
 
   cv::Mat scene_depth;
   if (with_depth) {
@@ -411,6 +439,7 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
 
   Target* result = scene_.get();
   if (post_pass_) {
+    const core::ScopedStage stage("post-process");
     const bool moving = params_.modelsMotion();
     const GLuint program = moving ? motion_program_ : post_program_;
     const auto at = [program](const char* name) { return glGetUniformLocation(program, name); };
@@ -476,12 +505,15 @@ RenderedImage CameraRenderer::render(const Eigen::Isometry3d& T_world_cam, std::
     result = output_.get();
   }
 
-  out.image.create(intrinsics_.height, intrinsics_.width, gray ? CV_8UC1 : CV_8UC3);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, result->framebuffer);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, intrinsics_.width, intrinsics_.height, gray ? GL_RED : GL_RGB,
-               GL_UNSIGNED_BYTE, out.image.data);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  {
+    const core::ScopedStage stage("readback");
+    out.image.create(intrinsics_.height, intrinsics_.width, gray ? CV_8UC1 : CV_8UC3);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, result->framebuffer);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, intrinsics_.width, intrinsics_.height, gray ? GL_RED : GL_RGB,
+                 GL_UNSIGNED_BYTE, out.image.data);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
   checkGl("rendering a camera image");
   if (params_.auto_exposure) {
     const cv::Scalar mean = cv::mean(out.image);

@@ -58,6 +58,8 @@ class CameraRenderer {
   double vignettingK() const;
   // The auto-exposure's gain for a frame at utime, from the frame before.
   double exposureGain(std::int64_t utime);
+  // Tells the terrain where the camera is likely to look next (tiles made ahead).
+  void expectNextViews(const DrawView& view, std::int64_t utime);
 
   TerrainRenderer& terrain_;
   CameraParams params_;
@@ -79,6 +81,9 @@ class CameraRenderer {
   double ae_gain_ = 1.0;
   double ae_last_mean_counts_ = 0.0;
   std::int64_t ae_last_utime_ = -1;
+  // The last frame's camera position and time, for where it will be next.
+  Eigen::Vector3d last_p_world_cam_m_ = Eigen::Vector3d::Zero();
+  std::int64_t last_utime_ = -1;
 };
 
 }  // namespace nadir::render

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/stage_times.h"
 #include "render/course_boards.h"
 #include "render/detail_texture.h"
 #include "render/gl.h"
@@ -184,6 +185,8 @@ void TerrainRendererParams::visit(core::ParamVisitor& v) {
                   "only)",
            .min = 0.01,
            .max = 1000});
+  v.field("prefetch_tiles", &prefetch_tiles,
+          {.doc = "make the imagery of tiles about to be seen on a worker thread (same pixels)"});
 }
 
 TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
@@ -237,6 +240,10 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   if (params_.objects_3d) objects_ = std::make_unique<GroundObjectRenderer>();
+  if (params_.prefetch_tiles) {
+    prefetcher_ = std::make_unique<terrain::TilePrefetcher>(
+        tiles_, params_.objects_3d ? params_.objects_max_texel_m : 0.0);
+  }
   checkGl("creating the terrain renderer");
 }
 
@@ -374,6 +381,14 @@ std::vector<terrain::TileId> TerrainRenderer::visibleTiles(const DrawView& view)
   return tiles_->select(lodViewOf(view));
 }
 
+void TerrainRenderer::expect(const std::vector<DrawView>& views) {
+  if (!prefetcher_) return;
+  std::vector<terrain::LodView> lod_views;
+  lod_views.reserve(views.size());
+  for (const DrawView& view : views) lod_views.push_back(lodViewOf(view));
+  prefetcher_->expect(std::move(lod_views));
+}
+
 TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, int& uploaded) {
   const std::uint64_t key = id.key();
   const auto found = gpu_tiles_.find(key);
@@ -381,6 +396,7 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
     lru_.splice(lru_.begin(), lru_, found->second->lru_position);
     return *found->second;
   }
+  const core::ScopedStage stage("new tile");
   const std::shared_ptr<const terrain::TileGeometry> geometry = tiles_->geometry(id);
   const int n = geometry->vertices_per_edge;
   const int q = n - 1;
@@ -419,10 +435,17 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
   // Where the objects stand up, the imagery leaves out their tops.
   const bool objects = objects_ && geometry->square.size_m / tiles_->params().texture_px <=
                                        params_.objects_max_texel_m;
-  const cv::Mat rgb = tiles_->imagery(id, objects);
-  // Nearest mip level, bilinear within it: cheaper than trilinear on llvmpipe,
-  // and the tile choice keeps the level near 0 (a texel about a pixel).
-  tile->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_NEAREST);
+  cv::Mat rgb;
+  {
+    const core::ScopedStage imagery_stage("imagery");
+    rgb = prefetcher_ ? prefetcher_->take(id) : tiles_->imagery(id, objects);
+  }
+  {
+    // Nearest mip level, bilinear within it: cheaper than trilinear on llvmpipe,
+    // and the tile choice keeps the level near 0 (a texel about a pixel).
+    const core::ScopedStage upload_stage("upload");
+    tile->texture = uploadRgbTexture(rgb, GL_LINEAR_MIPMAP_NEAREST);
+  }
   tile->bytes =
       vertices.size() * sizeof(float) + static_cast<std::size_t>(rgb.cols) * rgb.rows * 4 * 4 / 3;
   if (objects) {
@@ -444,6 +467,7 @@ void TerrainRenderer::evictBeyondBudget(const std::vector<terrain::TileId>& in_u
   while (gpu_bytes_ > budget && lru_.size() > in_use.size()) {
     const std::uint64_t key = lru_.back();
     lru_.pop_back();
+    if (prefetcher_) prefetcher_->released(key);
     const auto it = gpu_tiles_.find(key);
     gpu_bytes_ -= it->second->bytes;
     gpu_tiles_.erase(it);
@@ -452,7 +476,11 @@ void TerrainRenderer::evictBeyondBudget(const std::vector<terrain::TileId>& in_u
 
 DrawStats TerrainRenderer::draw(const DrawView& view) {
   DrawStats stats;
-  const std::vector<terrain::TileId> visible = visibleTiles(view);
+  std::vector<terrain::TileId> visible;
+  {
+    const core::ScopedStage stage("select tiles");
+    visible = visibleTiles(view);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);

@@ -15,6 +15,7 @@
 #include "render/camera_model.h"
 #include "terrain/course.h"
 #include "terrain/targets.h"
+#include "terrain/tile_prefetcher.h"
 #include "terrain/tiles.h"
 
 namespace nadir::render {
@@ -32,6 +33,9 @@ struct TerrainRendererParams {
   // the imagery's tops alone are drawn.
   bool objects_3d = false;
   double objects_max_texel_m = 1.5;
+  // Make the imagery of the tiles a camera is about to see on a worker thread,
+  // from spare cycles (terrain/tile_prefetcher.h); the pixels are the same.
+  bool prefetch_tiles = true;
 
   void visit(core::ParamVisitor& v);
 };
@@ -76,6 +80,11 @@ class TerrainRenderer {
 
   // Tile selection for a view (also what draw() uses).
   std::vector<terrain::TileId> visibleTiles(const DrawView& view);
+  // The views a camera expects to draw next, soonest first: their tiles'
+  // imagery is made ahead (with prefetch_tiles). Replaces the views given before.
+  void expect(const std::vector<DrawView>& views);
+  // What makes tiles ahead; null without prefetch_tiles.
+  const terrain::TilePrefetcher* prefetcher() const { return prefetcher_.get(); }
 
   std::size_t gpuBytes() const { return gpu_bytes_; }
   std::size_t gpuTiles() const { return gpu_tiles_.size(); }
@@ -88,6 +97,7 @@ class TerrainRenderer {
 
   std::shared_ptr<terrain::TileTree> tiles_;
   TerrainRendererParams params_;
+  std::unique_ptr<terrain::TilePrefetcher> prefetcher_;
   unsigned int program_plain_ = 0;
   unsigned int program_detail_ = 0;
   unsigned int index_buffer_ = 0;

@@ -13,6 +13,8 @@
 #include "core/bus.h"
 #include "core/clock.h"
 #include "core/lcm_log.h"
+#include "core/stage_times.h"
+#include "core/worker_bus.h"
 #include "lcmtypes/bus_io.h"
 #include "nodes/camera/camera_node.h"
 #include "nodes/registry.h"
@@ -36,6 +38,15 @@ namespace fs = std::filesystem;
 constexpr const char* kLogName = "run.lcmlog";
 constexpr const char* kMetricsName = "metrics.json";
 constexpr const char* kScenarioName = "scenario.yaml";
+constexpr const char* kStageTimesName = "stage_times.txt";
+
+// However a run ends, its stage timers stop with it.
+struct StageTimesOff {
+  StageTimesOff() = default;
+  StageTimesOff(const StageTimesOff&) = delete;
+  StageTimesOff& operator=(const StageTimesOff&) = delete;
+  ~StageTimesOff() { core::enableStageTimes(false); }
+};
 
 std::string defaultOutDir(const std::string& scenario) {
   return (fs::path("out") / fs::path(scenario).stem()).string();
@@ -45,6 +56,10 @@ std::string defaultOutDir(const std::string& scenario) {
 
 RunResult runScenario(const RunOptions& options,
                       const std::function<void(const RunProgress&)>& on_progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  core::enableStageTimes(options.stage_times);
+  core::clearStageTimes();
+  const StageTimesOff stop_timing_at_the_end;
   nodes::ScenarioParams scenario = nodes::loadScenario(options.scenario, options.overrides);
   terrain::requireFlightWorld(scenario.world);
   // Everything stays in this process: the bus is in-process whatever the file says.
@@ -90,6 +105,7 @@ RunResult runScenario(const RunOptions& options,
   const std::int64_t start_utime = sim::runStartUtime(scenario.time);
   std::optional<std::int64_t> event_offset_us;
   core::Subscription recorder = bus->subscribe(".*", [&](const core::RawMessage& raw) {
+    const core::ScopedStage stage("record");
     ++result.totals.messages;
     const std::string channel(raw.channel);
     if (unrecorded.count(channel) != 0) return;
@@ -109,55 +125,92 @@ RunResult runScenario(const RunOptions& options,
   cv::Mat last_image;
   render::TextureMeter texture;
   std::optional<std::int64_t> last_measured_utime;
-  core::Subscription last_image_keeper =
-      msg::subscribe<msg::Image>(*bus, scenario.camera.channel, [&](const msg::Image& image) {
-        last_image = image.pixels;
-        if (!last_measured_utime || image.utime - *last_measured_utime >= 1'000'000) {
-          texture.add(image.pixels);
-          last_measured_utime = image.utime;
-        }
-      });
+  camera.onFrame([&](const camera::CameraFrame& frame) {
+    if (frame.spec->channel != scenario.camera.channel) return;
+    last_image = frame.rendered.image;
+    const std::int64_t utime = frame.rendered.utime;
+    if (!last_measured_utime || utime - *last_measured_utime >= 1'000'000) {
+      const core::ScopedStage stage("texture");
+      texture.add(frame.rendered.image);
+      last_measured_utime = utime;
+    }
+  });
   const core::LocalNedFrame frame(camera.scene().built.origin);
   sim::Simulator simulator(scenario.sim, camera.scene().built.world, frame,
                            sim::loadFlight(scenario.sim.flight, frame));
   sim::SimPublisher publisher(*bus, scenario.sim, simulator);
   sim::DriveCommandInput drive_commands(*bus, scenario.sim, simulator);
   sim::GuidanceInput guidance(*bus, scenario.sim, simulator);
+  // A node that takes camera frames works on its own thread.
+  std::vector<std::unique_ptr<core::WorkerBus>> worker_buses;
   std::vector<std::unique_ptr<nodes::Node>> running;
   for (const auto& [entry, params] : running_nodes) {
-    if (entry->info().role == nodes::EntryInfo::Role::kProcessing) {
+    if (entry->info().role != nodes::EntryInfo::Role::kProcessing) continue;
+    std::set<std::string> paced = entry->pacedChannels(params);
+    if (options.node_threads && !paced.empty()) {
+      worker_buses.push_back(std::make_unique<core::WorkerBus>(*bus, std::move(paced)));
+      running.push_back(entry->start(*worker_buses.back(), params));
+    } else {
       running.push_back(entry->start(*bus, params));
     }
   }
+  // Everything the nodes have to do and say, delivered.
+  const auto settle = [&] {
+    do {
+      for (const auto& worker : worker_buses) worker->sync();
+    } while (bus->handle(std::chrono::milliseconds(0)) || bus->handleAvailable() > 0);
+  };
 
-  const auto wall_start = std::chrono::steady_clock::now();
-  auto last_report = wall_start;
+  const auto flight_start = std::chrono::steady_clock::now();
+  if (options.stage_times) {
+    core::addStageTime("setup", std::chrono::duration<double>(flight_start - wall_start).count(),
+                       1);
+  }
+  auto last_report = flight_start;
   const auto report = [&](bool force_report) {
     const auto now = std::chrono::steady_clock::now();
     if (!on_progress || (!force_report && now - last_report < std::chrono::milliseconds(500))) {
       return;
     }
     last_report = now;
-    result.totals.wall_s = std::chrono::duration<double>(now - wall_start).count();
+    result.totals.wall_s = std::chrono::duration<double>(now - flight_start).count();
     result.totals.frames = camera.framesPublished();
     on_progress(result.totals);
   };
   result.totals.planned_s = scenario.sim.duration_s;
   while (!simulator.finished()) {
-    const sim::SimOutput output = simulator.step();
+    sim::SimOutput output;
+    {
+      const core::ScopedStage stage("simulator");
+      output = simulator.step();
+    }
     result.totals.sim_s = core::secondsFromUtime(output.truth.utime - simulator.startUtime());
-    publisher.publish(output);
-    // Deliver everything this step caused (images, estimates) before the next step.
-    while (bus->handle(std::chrono::milliseconds(0))) {
+    {
+      const core::ScopedStage stage("simulator publish");
+      publisher.publish(output);
+    }
+    {
+      // Deliver everything this step caused (images, estimates) before the next step.
+      const core::ScopedStage stage("deliver");
+      while (bus->handle(std::chrono::milliseconds(0))) {
+      }
     }
     report(false);
   }
+  {
+    const core::ScopedStage stage("deliver");
+    settle();
+  }
   result.totals.frames = camera.framesPublished();
   report(true);
-  log.flush();
+  {
+    const core::ScopedStage stage("record");
+    log.flush();
+  }
 
   eval::EvalOptions eval_options;
   eval_options.tum_axes = options.tum_axes;
+  std::optional<core::ScopedStage> evaluation_stage(std::in_place, "evaluation");
   const eval::RunEvaluation evaluation =
       eval::evaluateRunLog(result.log_path, out.string(), eval_options, scenario.sim.truth.channel);
   result.metrics = evaluation.metrics;
@@ -178,12 +231,23 @@ RunResult runScenario(const RunOptions& options,
       scenario, result.log_path, evaluation.recorded, result.out_dir, *camera.scene().built.world,
       &course};
   for (const auto& [entry, params] : running_nodes) {
+    const core::ScopedStage stage("node reports");
     const std::string section = entry->batchReport(report_input, params);
     if (!section.empty()) result.table += "\n" + section;
   }
   if (course) {
     result.metrics.course = course;
     eval::writeMetricsJson(result.metrics_path, result.metrics, eval::EvalOptions{});
+  }
+  evaluation_stage.reset();
+  if (options.stage_times) {
+    const double wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    result.stage_times = core::formatStageTimes(core::stageTimes(), wall_s,
+                                                static_cast<std::int64_t>(result.totals.frames));
+    result.stage_times += "wall time " + std::to_string(wall_s) + " s, " +
+                          std::to_string(result.totals.frames) + " frames\n";
+    std::ofstream(out / kStageTimesName) << result.stage_times;
   }
   return result;
 }

@@ -33,6 +33,14 @@ struct RunOptions {
   // The axes of the TUM files written (core/axes.h); the log and metrics are
   // nadir's whatever they are.
   core::Axes tum_axes = core::Axes::kNed;
+  // Nodes that take camera frames (the VO nodes) work on their own threads
+  // while the camera renders the next frame; their outputs reach the others
+  // with the next frame (core/worker_bus.h). false: all in the bus's dispatch
+  // on one thread, their outputs at once. Deterministic either way.
+  bool node_threads = true;
+  // Time the pipeline's stages (core/stage_times.h) and report where the wall
+  // time went, in RunResult::stage_times and DIR/stage_times.txt.
+  bool stage_times = false;
 };
 
 struct RunProgress {
@@ -55,6 +63,8 @@ struct RunResult {
   RunProgress totals;
   // The metrics table, then what the nodes add (the PPA's target passes).
   std::string table;
+  // With RunOptions::stage_times: the table of where the wall time went.
+  std::string stage_times;
 };
 
 // Flies the scenario and evaluates it. on_progress is called about every

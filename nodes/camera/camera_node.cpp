@@ -1,5 +1,6 @@
 #include "nodes/camera/camera_node.h"
 
+#include "core/stage_times.h"
 #include "lcmtypes/bus_io.h"
 
 namespace nadir::camera {
@@ -18,6 +19,7 @@ void CameraNode::dropPose(const std::string& reason) {
 }
 
 void CameraNode::onPose(const msg::Pose& pose) {
+  const core::ScopedStage stage("camera");
   Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
   T_world_body.linear() = pose.q_world_body.toRotationMatrix();
   T_world_body.translation() = pose.p_ned_m;
@@ -25,6 +27,7 @@ void CameraNode::onPose(const msg::Pose& pose) {
     msg::publish(
         bus_, frame.spec->channel,
         msg::Image{frame.rendered.utime, frame.rendered.image, frame.spec->jpeg_quality, {}});
+    if (observer_) observer_(frame);
     // camera_info_t with the first frame, then once a second (and after a jump back).
     auto [last, first] = last_info_utime_.try_emplace(frame.name, pose.utime);
     if (first || pose.utime - last->second >= 1'000'000 || pose.utime < last->second) {

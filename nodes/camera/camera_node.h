@@ -4,6 +4,7 @@
 // a second) its camera_info_t out. Bad poses are dropped and counted.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -20,6 +21,12 @@ class CameraNode {
   // Builds the world, the GL context and the cameras (the context stays
   // current on this thread), then subscribes to params.pose_channel.
   CameraNode(core::Bus& bus, const CameraNodeParams& params);
+
+  // Called with every frame as it is published (in this process: the image
+  // itself, no copy of its pixels), before the bus delivers it.
+  void onFrame(std::function<void(const CameraFrame&)> observer) {
+    observer_ = std::move(observer);
+  }
 
   const GroundScene& scene() const { return scene_; }
   std::uint64_t framesPublished() const { return frames_; }
@@ -38,6 +45,7 @@ class CameraNode {
   std::uint64_t frames_ = 0;
   std::uint64_t bad_poses_ = 0;
   std::string first_bad_pose_;
+  std::function<void(const CameraFrame&)> observer_;
   core::Subscription subscription_;
 };
 

@@ -48,6 +48,9 @@ class VoDirectEntry final : public TypedEntry<vo::VoDirectNodeParams> {
   std::unique_ptr<Node> build(core::Bus& bus, const vo::VoDirectNodeParams& params) const override {
     return std::make_unique<VoDirectLiveNode>(bus, params);
   }
+  std::set<std::string> paced(const vo::VoDirectNodeParams& params) const override {
+    return {params.image_channel};
+  }
   std::vector<Stream> publishes(const vo::VoDirectNodeParams& params) const override {
     return {{.channel = params.pose_channel}, {.channel = params.debug_channel, .bulky = true}};
   }

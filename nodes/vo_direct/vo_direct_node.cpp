@@ -4,10 +4,25 @@
 #include <cstdio>
 #include <variant>
 
+#include "core/stage_times.h"
 #include "lcmtypes/bus_io.h"
 #include "nodes/vo_direct/debug_image.h"
 
 namespace nadir::vo {
+namespace {
+
+// The VO's own stage clocks for one frame, as stages of the run's profile.
+void addStageTimes(const DirectVoTiming& before, const DirectVoTiming& after) {
+  if (!core::stageTimesEnabled()) return;
+  core::addStageTime("pyramid", after.pyramid_s - before.pyramid_s);
+  core::addStageTime("track", after.track_s - before.track_s);
+  if (after.keyframe_s > before.keyframe_s)
+    core::addStageTime("key-frame", after.keyframe_s - before.keyframe_s);
+  if (after.window_s > before.window_s)
+    core::addStageTime("window optimisation", after.window_s - before.window_s);
+}
+
+}  // namespace
 
 void VoDirectNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the direct VO in this scenario"});
@@ -59,6 +74,7 @@ void VoDirectNode::drop(const std::string& reason) {
 }
 
 void VoDirectNode::onImage(const msg::Image& image) {
+  const core::ScopedStage stage("vo_direct");
   for (const nodes::VoResetRequest& request : pending_resets_) {
     if (request.T_world_body && !started_) {
       // A pose given stands for the start pose the truth would give.
@@ -77,7 +93,13 @@ void VoDirectNode::onImage(const msg::Image& image) {
   const VoFrameInput& input = std::get<VoFrameInput>(made);
 
   const auto started = std::chrono::steady_clock::now();
-  const DirectVoOutput out = vo_.process(input);
+  DirectVoOutput out;
+  {
+    const core::ScopedStage process_stage("process");
+    const DirectVoTiming before = vo_.timing();
+    out = vo_.process(input);
+    addStageTimes(before, vo_.timing());
+  }
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   processing_s_ += elapsed_s;
@@ -99,6 +121,7 @@ void VoDirectNode::onImage(const msg::Image& image) {
 }
 
 void VoDirectNode::publishDebugImage(std::int64_t utime, const DirectVoOutput& out) {
+  const core::ScopedStage stage("debug image");
   if (vo_.keyframeImage().empty()) return;
   char text[160];
   std::snprintf(text, sizeof text,

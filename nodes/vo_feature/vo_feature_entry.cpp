@@ -52,6 +52,9 @@ class VoFeatureEntry final : public TypedEntry<vo::VoFeatureNodeParams> {
                               const vo::VoFeatureNodeParams& params) const override {
     return std::make_unique<VoFeatureLiveNode>(bus, params);
   }
+  std::set<std::string> paced(const vo::VoFeatureNodeParams& params) const override {
+    return {params.image_channel};
+  }
   std::vector<Stream> publishes(const vo::VoFeatureNodeParams& params) const override {
     return {{.channel = params.pose_channel}, {.channel = params.debug_channel, .bulky = true}};
   }

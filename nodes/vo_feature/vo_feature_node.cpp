@@ -4,9 +4,23 @@
 #include <variant>
 
 #include "core/frames.h"
+#include "core/stage_times.h"
 #include "lcmtypes/bus_io.h"
 
 namespace nadir::vo {
+namespace {
+
+// The VO's own stage clocks for one frame, as stages of the run's profile.
+void addStageTimes(const FeatureVoTiming& before, const FeatureVoTiming& after) {
+  if (!core::stageTimesEnabled()) return;
+  core::addStageTime("extract", after.extract_s - before.extract_s);
+  core::addStageTime("track", after.track_s - before.track_s);
+  if (after.keyframes > before.keyframes)
+    core::addStageTime("key-frame", after.mapping_s - before.mapping_s);
+}
+
+}  // namespace
+
 void VoFeatureNodeParams::visit(core::ParamVisitor& v) {
   v.field("enabled", &enabled, {.doc = "run the feature VO in this scenario"});
   v.field("image_channel", &image_channel, {.doc = "the camera's images (gray or RGB)"});
@@ -68,6 +82,7 @@ void VoFeatureNode::applyResets() {
 }
 
 void VoFeatureNode::onImage(const msg::Image& image) {
+  const core::ScopedStage stage("vo_feature");
   applyResets();
   auto made = source_.frame(image, params_.attitude_prior);
   if (const std::string* reason = std::get_if<std::string>(&made)) {
@@ -78,7 +93,13 @@ void VoFeatureNode::onImage(const msg::Image& image) {
   const VoFrameInput& input = std::get<VoFrameInput>(made);
 
   const auto started = std::chrono::steady_clock::now();
-  const VoFrameOutput out = vo_.process(input);
+  VoFrameOutput out;
+  {
+    const core::ScopedStage process_stage("process");
+    const FeatureVoTiming before = vo_.timing();
+    out = vo_.process(input);
+    addStageTimes(before, vo_.timing());
+  }
   const double elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   processing_s_ += elapsed_s;
@@ -101,6 +122,7 @@ void VoFeatureNode::onImage(const msg::Image& image) {
 
 void VoFeatureNode::publishDebugImage(const cv::Mat& frame, std::int64_t utime,
                                       const VoFrameOutput& out) {
+  const core::ScopedStage stage("debug image");
   const char* status = nodes::statusName(out.status);
   const std::vector<DebugFeature>& features = vo_.lastFrameFeatures();
   std::ostringstream text;
