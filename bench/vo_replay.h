@@ -49,6 +49,8 @@ class VoReplay {
            const std::string& debug_channel, std::string debug_png, double debug_at_s)
       : folder_(folder),
         image_channel_(image_channel),
+        pose_channel_(pose_channel),
+        debug_channel_(debug_channel),
         debug_png_(std::move(debug_png)),
         debug_at_s_(debug_at_s),
         writer_((folder.out / "run.lcmlog").string()) {
@@ -79,6 +81,8 @@ class VoReplay {
     bool saw_images = false;
     const auto start = std::chrono::steady_clock::now();
     while (auto event = reader.next()) {
+      // What the run's own VO published: the replay makes its own.
+      if (event->channel == pose_channel_ || event->channel == debug_channel_) continue;
       if (event->channel == image_channel_) {
         saw_images = true;
         if (!first_image_utime_) {
@@ -104,6 +108,8 @@ class VoReplay {
  private:
   RunFolder folder_;
   std::string image_channel_;
+  std::string pose_channel_;
+  std::string debug_channel_;
   std::string debug_png_;
   double debug_at_s_;
   core::LcmLogWriter writer_;
