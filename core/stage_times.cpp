@@ -2,7 +2,6 @@
 
 #include <atomic>
 #include <cstdio>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <unordered_map>

@@ -7,7 +7,9 @@
 namespace nadir::core {
 
 WorkerBus::WorkerBus(Bus& bus, std::set<std::string> paced_channels)
-    : bus_(bus), paced_channels_(std::move(paced_channels)), owner_(std::this_thread::get_id()) {
+    : bus_(bus),
+      paced_channels_(paced_channels.begin(), paced_channels.end()),
+      owner_(std::this_thread::get_id()) {
   worker_ = std::thread([this] { work(); });
 }
 
@@ -61,7 +63,7 @@ void WorkerBus::send(std::string_view channel, const void* data, std::size_t siz
 }
 
 void WorkerBus::give(const std::shared_ptr<const RawHandler>& handler, const RawMessage& raw) {
-  if (paced_channels_.count(std::string(raw.channel)) != 0) sync();
+  if (paced_channels_.find(raw.channel) != paced_channels_.end()) sync();
   {
     const std::lock_guard lock(mutex_);
     queue_.push_back({handler, std::string(raw.channel),

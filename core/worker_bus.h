@@ -67,7 +67,7 @@ class WorkerBus final : public Bus {
   void work();
 
   Bus& bus_;
-  const std::set<std::string> paced_channels_;
+  const std::set<std::string, std::less<>> paced_channels_;
   const std::thread::id owner_;
   std::unordered_map<int, Subscription> subscriptions_;  // on bus_, by this bus's id
 

@@ -241,8 +241,7 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<terrain::TileTree> tiles,
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   if (params_.objects_3d) objects_ = std::make_unique<GroundObjectRenderer>();
   if (params_.prefetch_tiles) {
-    prefetcher_ = std::make_unique<terrain::TilePrefetcher>(
-        tiles_, params_.objects_3d ? params_.objects_max_texel_m : 0.0);
+    prefetcher_ = std::make_unique<terrain::TilePrefetcher>(tiles_, objectsMaxTexel_m());
   }
   checkGl("creating the terrain renderer");
 }
@@ -433,8 +432,7 @@ TerrainRenderer::GpuTile& TerrainRenderer::acquire(const terrain::TileId& id, in
   glBindVertexArray(0);
 
   // Where the objects stand up, the imagery leaves out their tops.
-  const bool objects = objects_ && geometry->square.size_m / tiles_->params().texture_px <=
-                                       params_.objects_max_texel_m;
+  const bool objects = tiles_->beneathObjects(id, objectsMaxTexel_m());
   cv::Mat rgb;
   {
     const core::ScopedStage imagery_stage("imagery");

@@ -93,6 +93,10 @@ class TerrainRenderer {
  private:
   struct GpuTile;
   GpuTile& acquire(const terrain::TileId& id, int& uploaded);
+  // Tiles with texels this fine or finer have 3D objects standing on them (0: none).
+  double objectsMaxTexel_m() const {
+    return params_.objects_3d ? params_.objects_max_texel_m : 0.0;
+  }
   void evictBeyondBudget(const std::vector<terrain::TileId>& in_use);
 
   std::shared_ptr<terrain::TileTree> tiles_;

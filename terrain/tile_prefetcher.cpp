@@ -26,8 +26,7 @@ TilePrefetcher::~TilePrefetcher() {
 }
 
 bool TilePrefetcher::beneathObjects(const TileId& id) const {
-  return beneath_objects_max_texel_m_ > 0.0 &&
-         tiles_->squareOf(id).size_m / tiles_->params().texture_px <= beneath_objects_max_texel_m_;
+  return tiles_->beneathObjects(id, beneath_objects_max_texel_m_);
 }
 
 void TilePrefetcher::expect(std::vector<LodView> views) {

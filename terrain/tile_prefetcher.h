@@ -33,7 +33,7 @@ struct TilePrefetchStats {
 class TilePrefetcher {
  public:
   // beneath_objects_max_texel_m: tiles whose texel is at most this are made
-  // as World::imageryBeneathObjects (3D objects drawn on them); 0: none.
+  // as World::imageryBeneathObjects (TileTree::beneathObjects); 0: none.
   // max_ready: tiles made and not yet taken that are kept (those the latest
   // views no longer select go first).
   TilePrefetcher(std::shared_ptr<TileTree> tiles, double beneath_objects_max_texel_m,

@@ -179,6 +179,11 @@ void TileTree::selectInto(const TileId& id, const LodView& view, std::vector<Til
   out.push_back(id);
 }
 
+bool TileTree::beneathObjects(const TileId& id, double objects_max_texel_m) const {
+  return objects_max_texel_m > 0.0 &&
+         squareOf(id).size_m / params_.texture_px <= objects_max_texel_m;
+}
+
 cv::Mat TileTree::imagery(const TileId& id, bool beneath_objects) const {
   const GroundSquare sq = squareOf(id);
   const double texel_m = sq.size_m / params_.texture_px;

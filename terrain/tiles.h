@@ -82,6 +82,10 @@ class TileTree {
   // The square the root tile covers (the world extent's bounding square).
   GroundSquare rootSquare() const { return root_; }
   GroundSquare squareOf(const TileId& id) const;
+  // Whether 3D objects stand on a tile, its imagery then beneath them
+  // (World::imageryBeneathObjects): its texel is at most objects_max_texel_m
+  // (0: on none).
+  bool beneathObjects(const TileId& id, double objects_max_texel_m) const;
   int maxLevel() const { return max_level_; }
 
   // Tiles to draw for the view, coarse to fine, in a fixed order.
