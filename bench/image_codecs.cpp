@@ -35,7 +35,6 @@ namespace {
 using nadir::msg::Bytes;
 
 struct ChannelBytes {
-  std::int64_t messages = 0;
   std::int64_t data_bytes = 0;
   std::vector<std::int64_t> image_offsets;  // image_t events, file order
   bool jpeg = false;                        // any of them JPEG
@@ -176,7 +175,6 @@ int main(int argc, char** argv) {
     std::map<std::string, ChannelBytes> channels;
     while (auto event = reader.next()) {
       ChannelBytes& entry = channels[event->channel];
-      ++entry.messages;
       entry.data_bytes += static_cast<std::int64_t>(event->data.size());
       if (nadir::msg::isType<nadir::msg::Image>(event->data.data(), event->data.size())) {
         entry.image_offsets.push_back(event->offset);
